@@ -1,0 +1,152 @@
+"""Settings files: YAML mappings checked against a frozen dataclass.
+
+Each settings dataclass declares its keys as fields; a field's ``metadata`` (see
+:func:`setting`) may carry allowed ``choices``, inclusive ``min``/``max`` and ``help``. Loading
+rejects unknown keys, wrong types and out-of-range values with a one-line
+:class:`ConfigError` that names the file and the key.
+
+Used by the offline CLI and by the ROS nodes, so it depends on pyyaml only.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import math
+import os
+import sys
+import types
+import typing
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+
+class ConfigError(ValueError):
+    """A settings file or value is not valid; the message names the file and key."""
+
+
+def load_yaml_mapping(path: str | os.PathLike) -> dict[str, Any]:
+    """Read a YAML file whose top level is a mapping.
+
+    Raises:
+        ConfigError: the file is missing, not YAML, or not a mapping.
+
+    """
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError(f"{source}: no such settings file") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise ConfigError(f"{source}: cannot read ({e})") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(e, "problem", None) or "invalid YAML"
+        raise ConfigError(f"{source}: invalid YAML{where}: {problem}") from None
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise ConfigError(
+            f"{source}: expected a mapping of settings at the top level, got {type(data).__name__}"
+        )
+    return data
+
+
+def _field_types(cls) -> dict[str, Any]:
+    return typing.get_type_hints(cls, vars(sys.modules[cls.__module__]))
+
+
+def _check_value(name: str, value: Any, expected: Any, meta: dict, source: str) -> Any:
+    """Coerce and check one value against its declared type and metadata."""
+    origin = typing.get_origin(expected)
+    if origin in (typing.Union, types.UnionType):
+        options = [t for t in typing.get_args(expected) if t is not type(None)]
+        if value is None:
+            return None
+        expected = options[0]
+    if expected is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"{source}: {name} must be a number, got {value!r}")
+        value = float(value)
+        if not math.isfinite(value):
+            raise ConfigError(f"{source}: {name} must be finite, got {value!r}")
+    elif expected is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{source}: {name} must be an integer, got {value!r}")
+    elif expected is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(f"{source}: {name} must be true or false, got {value!r}")
+    elif expected is str:
+        if not isinstance(value, str):
+            raise ConfigError(f"{source}: {name} must be a string, got {value!r}")
+    elif typing.get_origin(expected) is tuple:
+        item = typing.get_args(expected)[0]
+        if not isinstance(value, (list, tuple)):
+            raise ConfigError(f"{source}: {name} must be a list, got {value!r}")
+        value = tuple(
+            _check_value(f"{name}[{i}]", v, item, {}, source) for i, v in enumerate(value)
+        )
+    choices = meta.get("choices")
+    if choices is not None and value not in choices:
+        raise ConfigError(
+            f"{source}: {name} must be one of {', '.join(map(str, choices))}; got {value!r}"
+        )
+    low, high = meta.get("min"), meta.get("max")
+    if low is not None and value < low:
+        raise ConfigError(f"{source}: {name} must be >= {low}, got {value!r}")
+    if high is not None and value > high:
+        raise ConfigError(f"{source}: {name} must be <= {high}, got {value!r}")
+    return value
+
+
+def build_settings(cls, values: dict[str, Any], source: str):
+    """Instantiate the settings dataclass ``cls`` from ``values``, checking every key.
+
+    Raises:
+        ConfigError: unknown key (with a suggestion), missing key, bad type or range.
+
+    """
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    hints = _field_types(cls)
+    for key in values:
+        if key not in fields:
+            close = difflib.get_close_matches(str(key), fields, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise ConfigError(
+                f"{source}: unknown setting {key!r}{hint}; known settings: {', '.join(fields)}"
+            )
+    kwargs = {}
+    for name, f in fields.items():
+        if name in values:
+            kwargs[name] = _check_value(name, values[name], hints[name], dict(f.metadata), source)
+        elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+            raise ConfigError(f"{source}: missing setting {name!r}")
+    return cls(**kwargs)
+
+
+def setting(
+    default: Any = dataclasses.MISSING, *, doc: str = "", choices=None, minimum=None, maximum=None
+):
+    """Declare a settings field with its documentation and allowed values (inclusive)."""
+    meta = {"help": doc, "choices": choices, "min": minimum, "max": maximum}
+    return dataclasses.field(default=default, metadata=meta)
+
+
+def config_dir() -> Path:
+    """Folder holding the shipped settings files (``config/`` of the project).
+
+    Looked up, in order: ``$EVORBC_CONFIG_DIR``; the source tree next to this package
+    (a checkout or editable install); ``<prefix>/share/evorbc_ros/config`` (installed).
+    """
+    env = os.environ.get("EVORBC_CONFIG_DIR")
+    if env:
+        return Path(env)
+    source_tree = Path(__file__).resolve().parents[1] / "config"
+    if source_tree.is_dir():
+        return source_tree
+    return Path(sys.prefix) / "share" / "evorbc_ros" / "config"

@@ -1,0 +1,1 @@
+"""Robot definitions shared by the onboard executor and the simulator."""

@@ -1,0 +1,1 @@
+"""Offline evolution for EvoRBC: MAP-Elites repertoires, NEAT arbitrators, tasks and plots."""

@@ -1,0 +1,1 @@
+"""Pictures of repertoires, runs and replays (matplotlib, PNG)."""

@@ -1,0 +1,1 @@
+"""Repertoire generation with MAP-Elites (paper Sec. III-A, Algorithm 1)."""

@@ -1,0 +1,242 @@
+"""Batch MAP-Elites (paper Algorithm 1) over a simulated robot's primitives.
+
+The loop is ask -> evaluate -> add: the emitter proposes genes, the robot executes them
+for T seconds from rest, the quality metric scores the outcome, and the archive keeps the
+best primitive per cell of final displacement. Runs are seeded and deterministic; they
+checkpoint every few iterations and resume to exactly the result of an uninterrupted run.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import ribs
+
+from evorbc_ros.repertoire import Repertoire
+from offline_evolution.checkpoint import (
+    CheckpointError,
+    load_checkpoint,
+    save_checkpoint,
+    settings_mismatch,
+)
+from offline_evolution.quality import quality_metric
+from offline_evolution.repertoire.archive import (
+    EXTRA_FIELDS,
+    elites_by_cell,
+    grid_layout,
+    make_archive,
+)
+from offline_evolution.repertoire.emitter import PaperMutationEmitter
+from offline_evolution.repertoire.settings import MapElitesSettings
+from sim_bridge.robots import SimulatedRobot, make_robot
+
+CHECKPOINT_KIND = "evorbc-map-elites-checkpoint"
+
+
+@dataclass(frozen=True)
+class Progress:
+    """A snapshot of a running MAP-Elites run, passed to the progress callback."""
+
+    iteration: int  # batches done after the initial batch (0 = only the initial batch)
+    iterations: int
+    evaluations: int
+    cells: int
+    mean_quality: float
+    qd_score: float
+    elapsed: float  # s of wall time in this process
+    resumed_from: int | None = None  # iteration the run resumed from, if any
+
+
+class Interrupted(Exception):
+    """The run was asked to stop; finished work is in the checkpoint."""
+
+    def __init__(self, iteration: int, checkpoint: str | None) -> None:
+        super().__init__(f"stopped after iteration {iteration}")
+        self.iteration = iteration
+        self.checkpoint = checkpoint
+
+
+class MapElites:
+    """One MAP-Elites run: archive, emitter and the iteration counter."""
+
+    def __init__(self, settings: MapElitesSettings, robot: SimulatedRobot | None = None):
+        self.settings = settings
+        self.robot = robot or make_robot(settings.robot)
+        self.metric = quality_metric(settings.metric)
+        self.layout = grid_layout(self.robot.max_reach(settings.eval_time), settings.bin_size)
+        d = len(self.robot.parameter_specs)
+        self.archive = make_archive(self.layout, d, settings.seed)
+        self.emitter = PaperMutationEmitter(
+            self.archive,
+            initial_batch=settings.initial_batch,
+            batch_size=settings.batch_size,
+            mutation_probability=settings.mutation_probability,
+            sigma=settings.mutation_sigma,
+            seed=settings.seed,
+        )
+        self.batches_done = 0  # the initial batch counts as batch 1
+        self.evaluations = 0
+
+    @property
+    def iteration(self) -> int:
+        """Iterations completed after the initial batch."""
+        return max(0, self.batches_done - 1)
+
+    @property
+    def finished(self) -> bool:
+        """True once the initial batch and every iteration have run."""
+        return self.batches_done >= 1 + self.settings.iterations
+
+    def step(self) -> None:
+        """Run one batch: ask, evaluate, score, add."""
+        genes = self.emitter.ask()
+        outcome = self.robot.evaluate_primitives(genes, self.settings.eval_time)
+        quality = self.metric(outcome)
+        keep = np.isfinite(quality)  # NaN: discarded (e.g. a legged robot fell over)
+        self.archive.add(
+            genes[keep],
+            quality[keep],
+            outcome.displacement[keep],
+            heading=outcome.heading[keep],
+        )
+        self.batches_done += 1
+        self.evaluations += len(genes)
+
+    def progress(self, elapsed: float, resumed_from: int | None = None) -> Progress:
+        """Current figures of the run."""
+        q = self.archive.data("objective")
+        return Progress(
+            iteration=self.iteration,
+            iterations=self.settings.iterations,
+            evaluations=self.evaluations,
+            cells=len(self.archive),
+            mean_quality=float(q.mean()) if len(q) else 0.0,
+            qd_score=float(q.sum()),
+            elapsed=elapsed,
+            resumed_from=resumed_from,
+        )
+
+    def repertoire(self) -> Repertoire:
+        """The archive as a :class:`Repertoire`, primitives ordered by cell."""
+        elites = elites_by_cell(self.archive)
+        s = self.settings
+        return Repertoire(
+            robot=self.robot.name,
+            parameters=self.robot.parameter_specs,
+            genes=elites["solution"],
+            behaviour=elites["measures"],
+            heading=elites["heading"],
+            quality=elites["objective"],
+            metric=s.metric,
+            eval_time=s.eval_time,
+            bin_size=s.bin_size,
+            seed=s.seed,
+            archive=self.layout,
+            algorithm={
+                "name": "MAP-Elites (batch, paper Algorithm 1)",
+                "initial_batch": s.initial_batch,
+                "batch_size": s.batch_size,
+                "iterations": s.iterations,
+                "mutation_probability": s.mutation_probability,
+                "mutation_sigma": s.mutation_sigma,
+                "variation": s.variation,
+                "evaluations": self.evaluations,
+                "library": f"pyribs {ribs.__version__}",
+            },
+        )
+
+    # -- checkpoints -------------------------------------------------------------------
+
+    def save(self, path: str | os.PathLike) -> None:
+        """Write a checkpoint of the finished batches."""
+        elites = elites_by_cell(self.archive)
+        header = {
+            "kind": CHECKPOINT_KIND,
+            "settings": self.settings.as_dict(),
+            "batches_done": self.batches_done,
+            "evaluations": self.evaluations,
+            "emitter": self.emitter.get_state(),
+        }
+        arrays = {k: elites[k] for k in ("solution", "objective", "measures", *EXTRA_FIELDS)}
+        save_checkpoint(path, header, arrays)
+
+    def restore(self, path: str | os.PathLike) -> None:
+        """Continue from a checkpoint written by :meth:`save` for the same settings.
+
+        Raises:
+            CheckpointError: unusable file, or written for different settings.
+
+        """
+        header, arrays = load_checkpoint(path)
+        if header.get("kind") != CHECKPOINT_KIND:
+            raise CheckpointError(f"{path}: not a MAP-Elites checkpoint")
+        mismatch = settings_mismatch(header.get("settings", {}), self.settings.as_dict())
+        if mismatch:
+            raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
+        try:
+            self.archive.clear()
+            if len(arrays["objective"]):
+                self.archive.add(
+                    arrays["solution"],
+                    arrays["objective"],
+                    arrays["measures"],
+                    **{k: arrays[k] for k in EXTRA_FIELDS},
+                )
+            self.emitter.set_state(header["emitter"])
+            self.batches_done = int(header["batches_done"])
+            self.evaluations = int(header["evaluations"])
+        except (KeyError, ValueError, TypeError) as e:
+            raise CheckpointError(f"{path}: not a usable checkpoint ({e})") from None
+
+
+def generate_repertoire(
+    settings: MapElitesSettings,
+    *,
+    robot: SimulatedRobot | None = None,
+    checkpoint: str | os.PathLike | None = None,
+    checkpoint_every: int = 100,
+    progress: Callable[[Progress], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> Repertoire:
+    """Run MAP-Elites to the end and return the repertoire.
+
+    Args:
+        settings: the run's settings (Table I defaults come from ``config/``).
+        robot: the simulated robot; by default the one ``settings.robot`` names.
+        checkpoint: file to resume from if it exists, and to save to every
+            ``checkpoint_every`` iterations; removed once the run finishes.
+        progress: called after every batch with a :class:`Progress`.
+        should_stop: polled after every batch; if it returns True the run saves its
+            checkpoint and raises :class:`Interrupted`.
+
+    Raises:
+        CheckpointError: the checkpoint exists but belongs to another run or is corrupt.
+        Interrupted: ``should_stop`` asked to stop.
+
+    """
+    run = MapElites(settings, robot)
+    resumed_from = None
+    if checkpoint is not None and os.path.exists(checkpoint):
+        run.restore(checkpoint)
+        resumed_from = run.iteration
+    start = time.perf_counter()
+    while not run.finished:
+        run.step()
+        if progress is not None:
+            progress(run.progress(time.perf_counter() - start, resumed_from))
+        due = checkpoint is not None and run.batches_done % max(1, checkpoint_every) == 0
+        stop = should_stop is not None and should_stop() and not run.finished
+        if due or (stop and checkpoint is not None):
+            run.save(checkpoint)
+        if stop:
+            raise Interrupted(run.iteration, None if checkpoint is None else str(checkpoint))
+    if checkpoint is not None and os.path.exists(checkpoint):
+        os.remove(checkpoint)
+    return run.repertoire()
+
+
+__all__ = ["Interrupted", "MapElites", "Progress", "generate_repertoire"]

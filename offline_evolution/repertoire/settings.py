@@ -1,0 +1,76 @@
+"""Settings of a MAP-Elites repertoire run (paper Algorithm 1 and Table I).
+
+The defaults for each robot family live in ``config/repertoire/<family>.yaml``; the CLI
+loads that file and applies command-line overrides on top.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from evorbc_ros.config import build_settings, config_dir, load_yaml_mapping, setting
+from offline_evolution.quality import METRICS
+from sim_bridge.robots import ROBOT_NAMES
+
+ARCHIVES = ("grid",)
+VARIATIONS = ("paper",)
+
+
+@dataclass(frozen=True)
+class MapElitesSettings:
+    """Everything that determines a repertoire run's result (seed included)."""
+
+    robot: str = setting(doc="robot type", choices=ROBOT_NAMES)
+    metric: str = setting(doc="quality metric", choices=tuple(METRICS))
+    bin_size: float = setting(doc="side of a square archive cell (m)", minimum=1e-4)
+    eval_time: float = setting(doc="primitive evaluation time T (s)", minimum=0.1)
+    initial_batch: int = setting(doc="random solutions in the first batch (S_G)", minimum=1)
+    batch_size: int = setting(doc="mutants per iteration (S_B)", minimum=1)
+    iterations: int = setting(doc="iterations after the initial batch (I)", minimum=0)
+    mutation_probability: float = setting(
+        0.25, doc="per-gene mutation probability", minimum=0.0, maximum=1.0
+    )
+    mutation_sigma: float = setting(0.5, doc="sd of the Gaussian gene mutation", minimum=0.0)
+    seed: int = setting(0, doc="seed of every random choice of the run", minimum=0)
+    archive: str = setting("grid", doc="archive kind", choices=ARCHIVES)
+    variation: str = setting("paper", doc="variation operator", choices=VARIATIONS)
+
+    @property
+    def evaluations(self) -> int:
+        """Primitive evaluations the full run makes (S_G + I * S_B)."""
+        return self.initial_batch + self.iterations * self.batch_size
+
+    def as_dict(self) -> dict:
+        """Plain-data form (for repertoire metadata and checkpoints)."""
+        return dataclasses.asdict(self)
+
+
+def robot_family(robot: str) -> str:
+    """Name of the settings file family for ``robot`` (``4ws`` or ``hexapod``)."""
+    return "hexapod" if robot == "hexapod" else "4ws"
+
+
+def default_settings_file(robot: str) -> Path:
+    """The shipped settings file for ``robot``'s family."""
+    return config_dir() / "repertoire" / f"{robot_family(robot)}.yaml"
+
+
+def load_settings(path: str | os.PathLike | None = None, **overrides) -> MapElitesSettings:
+    """Settings from a YAML file with ``overrides`` (``None`` values are ignored) on top.
+
+    Without ``path`` the shipped file of the robot family is used; the robot comes from
+    ``overrides`` or the file.
+
+    Raises:
+        evorbc_ros.config.ConfigError: naming the file and the offending key.
+
+    """
+    overrides = {k: v for k, v in overrides.items() if v is not None}
+    if path is None:
+        path = default_settings_file(overrides.get("robot", "4ws-5"))
+    values = load_yaml_mapping(path)
+    values.update(overrides)
+    return build_settings(MapElitesSettings, values, str(path))

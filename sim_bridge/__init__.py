@@ -1,0 +1,1 @@
+"""The simulated world: robot motion models, mazes, sensors and the PyBullet bridge."""

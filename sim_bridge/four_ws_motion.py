@@ -1,0 +1,305 @@
+"""The 4WS motion model (DESIGN.md section 2), compiled with numba and batched.
+
+This is the one motion model used everywhere: repertoire generation, the maze task and the
+simulation bridge all call :func:`step_robot`. Everything here works on plain floats and
+float64 arrays so that numba can inline it into the batched loops of the callers.
+
+Robot state, one row per robot, world frame (REP 103):
+``[x m, y m, heading rad, speed m/s, angle_fl, angle_fr, angle_rl, angle_rr (rad)]``.
+The heading is not wrapped, so a primitive's net rotation stays readable.
+
+A wheel command is ``(speed m/s, angle_fl, angle_fr, angle_rl, angle_rr rad)``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numba as nb
+import numpy as np
+
+from evorbc_ros.robots.four_ws import FourWSGeometry
+
+STATE_SIZE = 8
+X, Y, HEADING, SPEED, ANGLE_FL, ANGLE_FR, ANGLE_RL, ANGLE_RR = range(STATE_SIZE)
+
+# Two axle lines whose directions differ by less than this (rad) are taken as parallel:
+# their intersection would lie further than ~0.05 m / 1e-9 = 5e7 m away.
+_PARALLEL_EPS = 1e-9
+
+
+class MotionLimits(NamedTuple):
+    """The geometry and limits that the compiled kernels need, as plain floats."""
+
+    wheel_x: float
+    wheel_y: float
+    footprint_radius: float
+    max_angle: float  # rad
+    max_angle_step: float  # rad per control step
+    max_speed: float  # m/s
+    max_speed_step: float  # m/s per control step
+    dt: float  # s
+    tan_max_slip: float
+    parallel_tolerance: float  # rad
+
+
+def motion_limits(geometry: FourWSGeometry) -> MotionLimits:
+    """Pack a :class:`FourWSGeometry` for the compiled kernels."""
+    dt = geometry.control_period
+    return MotionLimits(
+        wheel_x=geometry.wheel_x,
+        wheel_y=geometry.wheel_y,
+        footprint_radius=geometry.footprint_radius,
+        max_angle=geometry.max_wheel_angle,
+        max_angle_step=geometry.max_wheel_rate * dt,
+        max_speed=geometry.max_speed,
+        max_speed_step=geometry.max_acceleration * dt,
+        dt=dt,
+        tan_max_slip=math.tan(geometry.max_slip),
+        parallel_tolerance=geometry.parallel_tolerance,
+    )
+
+
+@nb.njit(cache=True, inline="always")
+def _approach(value, target, max_step):
+    """Move ``value`` towards ``target`` by at most ``max_step``."""
+    delta = target - value
+    if delta > max_step:
+        delta = max_step
+    elif delta < -max_step:
+        delta = -max_step
+    return value + delta
+
+
+@nb.njit(cache=True, inline="always")
+def _clip(value, bound):
+    return min(max(value, -bound), bound)
+
+
+@nb.njit(cache=True)
+def axle_intersection(px1, py1, a1, px2, py2, a2):
+    """Intersection of the axle lines of two wheels (body frame).
+
+    A wheel at ``p`` steered by ``a`` rolls along ``(cos a, sin a)``; its axle line is
+    ``p + t (-sin a, cos a)``.
+
+    Returns:
+        ``(exists, x, y)``; ``exists`` is False for parallel axles.
+
+    """
+    den = math.sin(a2 - a1)  # cross product of the two unit axle directions
+    if abs(den) < _PARALLEL_EPS:
+        return False, 0.0, 0.0
+    dx = px2 - px1
+    dy = py2 - py1
+    t = (dx * math.cos(a2) + dy * math.sin(a2)) / den
+    return True, px1 - t * math.sin(a1), py1 + t * math.cos(a1)
+
+
+@nb.njit(cache=True)
+def _slips(icr_x, icr_y, px, py, angle, tan_max_slip):
+    """True if the wheel at ``(px, py)`` steered by ``angle`` slips more than allowed.
+
+    The slip is the angle between the wheel's axle line and the line from the wheel to the
+    ICR; comparing tangents avoids an atan2 in the hot loop.
+    """
+    ux = -math.sin(angle)
+    uy = math.cos(angle)
+    wx = icr_x - px
+    wy = icr_y - py
+    cross = abs(ux * wy - uy * wx)
+    dot = abs(ux * wx + uy * wy)
+    return cross > tan_max_slip * dot
+
+
+@nb.njit(cache=True)
+def body_motion(a_fl, a_fr, a_rl, a_rr, distance, lim):
+    """Displacement of the body over one step, in the body frame at the start of the step.
+
+    Args:
+        a_fl, a_fr, a_rl, a_rr: wheel angles (rad) after rate limiting.
+        distance: signed distance the wheels roll this step (speed * dt, m).
+        lim: :class:`MotionLimits`.
+
+    Returns:
+        ``(moved, dx, dy, dheading)``. ``moved`` is False when the wheels fight each other
+        (slip above the limit, or the ICR inside the wheel rectangle).
+
+    """
+    hx = lim.wheel_x
+    hy = lim.wheel_y
+    a_max = max(max(a_fl, a_fr), max(a_rl, a_rr))
+    a_min = min(min(a_fl, a_fr), min(a_rl, a_rr))
+    a_mean = 0.25 * (a_fl + a_fr + a_rl + a_rr)
+    if a_max - a_min <= lim.parallel_tolerance:
+        # Crab motion: translate along the common wheel direction, heading unchanged.
+        return True, distance * math.cos(a_mean), distance * math.sin(a_mean), 0.0
+
+    ok_l, lx, ly = axle_intersection(hx, hy, a_fl, -hx, hy, a_rl)
+    ok_r, rx, ry = axle_intersection(hx, -hy, a_fr, -hx, -hy, a_rr)
+    if ok_l and ok_r:
+        icr_x = 0.5 * (lx + rx)
+        icr_y = 0.5 * (ly + ry)
+    elif ok_l:
+        icr_x, icr_y = lx, ly
+    elif ok_r:
+        icr_x, icr_y = rx, ry
+    else:
+        # Each side's wheels are parallel but the sides differ: the ICR is at infinity, so
+        # the body would translate along the mean direction; each wheel slips by its
+        # deviation from that direction.
+        tan_dev = max(
+            max(abs(math.tan(a_fl - a_mean)), abs(math.tan(a_fr - a_mean))),
+            max(abs(math.tan(a_rl - a_mean)), abs(math.tan(a_rr - a_mean))),
+        )
+        if tan_dev > lim.tan_max_slip:
+            return False, 0.0, 0.0, 0.0
+        return True, distance * math.cos(a_mean), distance * math.sin(a_mean), 0.0
+
+    # One shared wheel speed cannot spin the body about a point inside the wheel rectangle.
+    if abs(icr_x) <= hx and abs(icr_y) <= hy:
+        return False, 0.0, 0.0, 0.0
+    if (
+        _slips(icr_x, icr_y, hx, hy, a_fl, lim.tan_max_slip)
+        or _slips(icr_x, icr_y, hx, -hy, a_fr, lim.tan_max_slip)
+        or _slips(icr_x, icr_y, -hx, hy, a_rl, lim.tan_max_slip)
+        or _slips(icr_x, icr_y, -hx, -hy, a_rr, lim.tan_max_slip)
+    ):
+        return False, 0.0, 0.0, 0.0
+
+    # Sense of rotation: rolling forward, each wheel moves along (cos a, sin a); a rotation
+    # omega about the ICR moves a wheel at p with omega * z x (p - icr). Summing the
+    # projections over the wheels decides the sign robustly.
+    sense = 0.0
+    for px, py, a in ((hx, hy, a_fl), (hx, -hy, a_fr), (-hx, hy, a_rl), (-hx, -hy, a_rr)):
+        sense += math.cos(a) * (icr_y - py) - math.sin(a) * (icr_x - px)
+    radius = math.hypot(icr_x, icr_y)
+    dheading = distance / radius
+    if sense < 0.0:
+        dheading = -dheading
+    # The centre rotates about the ICR by dheading: new centre = (I - Rot) icr. Using
+    # 1 - cos = 2 sin^2(./2) keeps this exact for far-away ICRs (nearly straight arcs).
+    s = math.sin(dheading)
+    h = math.sin(0.5 * dheading)
+    c = 2.0 * h * h
+    dx = c * icr_x + s * icr_y
+    dy = -s * icr_x + c * icr_y
+    return True, dx, dy, dheading
+
+
+@nb.njit(cache=True)
+def apply_rate_limits(state, i, command, lim):
+    """Move robot ``i``'s speed and wheel angles towards ``command`` for one step.
+
+    Commands beyond the actuator ranges are clipped first.
+    """
+    state[i, SPEED] = _approach(
+        state[i, SPEED], _clip(command[0], lim.max_speed), lim.max_speed_step
+    )
+    for w in range(4):
+        state[i, ANGLE_FL + w] = _approach(
+            state[i, ANGLE_FL + w], _clip(command[1 + w], lim.max_angle), lim.max_angle_step
+        )
+
+
+@nb.njit(cache=True)
+def segment_clearance(px, py, walls):
+    """Smallest distance from ``(px, py)`` to the surface of any wall (m).
+
+    Args:
+        walls: ``(m, 5)`` rows ``(x1, y1, x2, y2, half_thickness)`` in the world frame.
+
+    """
+    best = np.inf
+    for k in range(walls.shape[0]):
+        x1 = walls[k, 0]
+        y1 = walls[k, 1]
+        ex = walls[k, 2] - x1
+        ey = walls[k, 3] - y1
+        qx = px - x1
+        qy = py - y1
+        length2 = ex * ex + ey * ey
+        t = 0.0
+        if length2 > 0.0:
+            t = min(max((qx * ex + qy * ey) / length2, 0.0), 1.0)
+        d = math.hypot(qx - t * ex, qy - t * ey) - walls[k, 4]
+        if d < best:
+            best = d
+    return best
+
+
+@nb.njit(cache=True)
+def step_robot(state, i, command, lim, walls):
+    """Advance robot ``i`` by one control step of ``lim.dt`` seconds.
+
+    Rate limits apply first; the body then moves with the limited speed and wheel angles.
+    If the footprint would overlap a wall after the step, the position stays where it was
+    and the heading change is kept (DESIGN.md section 2).
+
+    Args:
+        state: ``(n, STATE_SIZE)`` robot states, updated in place.
+        i: row of the robot to step.
+        command: ``(5,)`` wheel command.
+        lim: :class:`MotionLimits`.
+        walls: ``(m, 5)`` wall segments (may have ``m = 0``).
+
+    Returns:
+        Distance the body centre travelled this step (m, >= 0).
+
+    """
+    apply_rate_limits(state, i, command, lim)
+    distance = state[i, SPEED] * lim.dt
+    moved, dx, dy, dheading = body_motion(
+        state[i, ANGLE_FL],
+        state[i, ANGLE_FR],
+        state[i, ANGLE_RL],
+        state[i, ANGLE_RR],
+        distance,
+        lim,
+    )
+    if not moved:
+        return 0.0
+    heading = state[i, HEADING]
+    c = math.cos(heading)
+    s = math.sin(heading)
+    nx = state[i, X] + c * dx - s * dy
+    ny = state[i, Y] + s * dx + c * dy
+    state[i, HEADING] = heading + dheading
+    if walls.shape[0] > 0 and segment_clearance(nx, ny, walls) < lim.footprint_radius:
+        return 0.0
+    state[i, X] = nx
+    state[i, Y] = ny
+    return abs(distance)
+
+
+@nb.njit(cache=True, parallel=True)
+def run_primitives(commands, n_steps, lim):
+    """Execute primitives from rest at the origin facing +x, in free space.
+
+    Each row of ``commands`` is held constant for ``n_steps`` control steps; rate limits
+    apply throughout (DESIGN.md section 2). Robots are independent, so the result does not
+    depend on the number of threads.
+
+    Args:
+        commands: ``(n, 5)`` wheel commands.
+        n_steps: number of control steps (T / dt).
+        lim: :class:`MotionLimits`.
+
+    Returns:
+        ``(n, 4)`` rows ``(x m, y m, final heading rad (unwrapped), path length m)``.
+
+    """
+    n = commands.shape[0]
+    out = np.empty((n, 4))
+    no_walls = np.empty((0, 5))
+    for i in nb.prange(n):
+        state = np.zeros((1, STATE_SIZE))
+        path = 0.0
+        for _ in range(n_steps):
+            path += step_robot(state, 0, commands[i], lim, no_walls)
+        out[i, 0] = state[0, X]
+        out[i, 1] = state[0, Y]
+        out[i, 2] = state[0, HEADING]
+        out[i, 3] = path
+    return out
