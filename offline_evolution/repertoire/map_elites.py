@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import ribs
 
+from evorbc_ros.config import ConfigError
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.checkpoint import (
     CheckpointError,
@@ -33,6 +34,7 @@ from offline_evolution.repertoire.archive import (
 from offline_evolution.repertoire.emitter import PaperMutationEmitter
 from offline_evolution.repertoire.settings import MapElitesSettings
 from sim_bridge.robots import SimulatedRobot, make_robot
+from sim_bridge.robots.base import control_steps
 
 CHECKPOINT_KIND = "evorbc-map-elites-checkpoint"
 
@@ -66,6 +68,10 @@ class MapElites:
     def __init__(self, settings: MapElitesSettings, robot: SimulatedRobot | None = None):
         self.settings = settings
         self.robot = robot or make_robot(settings.robot)
+        try:
+            control_steps(settings.eval_time, self.robot.control_period)
+        except ValueError as e:
+            raise ConfigError(f"eval_time of {self.robot.name}: {e}") from None
         self.metric = quality_metric(settings.metric)
         self.layout = grid_layout(self.robot.max_reach(settings.eval_time), settings.bin_size)
         d = len(self.robot.parameter_specs)

@@ -35,10 +35,26 @@ class PrimitiveOutcome:
         return np.column_stack([self.x, self.y])
 
 
+def control_steps(duration: float, period: float) -> int:
+    """Number of control steps in ``duration`` s.
+
+    Raises:
+        ValueError: ``duration`` is not a positive whole number of control periods.
+
+    """
+    steps = round(duration / period)
+    if steps < 1 or abs(steps * period - duration) > 1e-9:
+        raise ValueError(
+            f"must be a positive multiple of the {period:g} s control period, got {duration:g} s"
+        )
+    return steps
+
+
 class SimulatedRobot(Protocol):
     """A robot as the offline search sees it."""
 
     name: str
+    control_period: float  # s, primitives run for whole numbers of control periods
 
     @property
     def parameter_specs(self) -> tuple[ParameterSpec, ...]:

@@ -7,18 +7,7 @@ import numpy as np
 from evorbc_ros.robots.four_ws import FourWSGeometry, FourWSType, robot_type
 from evorbc_ros.robots.primitive import ParameterSpec
 from sim_bridge.four_ws_motion import motion_limits, run_primitives
-from sim_bridge.robots.base import PrimitiveOutcome
-
-
-def control_steps(duration: float, period: float) -> int:
-    """Number of control steps in ``duration`` s; it must be a whole number of periods."""
-    steps = round(duration / period)
-    if steps < 1 or abs(steps * period - duration) > 1e-9:
-        raise ValueError(
-            f"evaluation time {duration} s must be a positive multiple of the "
-            f"{period} s control period"
-        )
-    return steps
+from sim_bridge.robots.base import PrimitiveOutcome, control_steps
 
 
 class FourWSRobot:
@@ -29,6 +18,7 @@ class FourWSRobot:
         self.name = self.type.name
         self.geometry = geometry or FourWSGeometry()
         self._limits = motion_limits(self.geometry)
+        self.control_period = self.geometry.control_period
 
     @property
     def parameter_specs(self) -> tuple[ParameterSpec, ...]:

@@ -1,0 +1,66 @@
+"""Settings files: the shipped defaults are Table I; bad files give one-line errors."""
+
+import pytest
+
+from evorbc_ros.config import ConfigError, config_dir
+from offline_evolution.repertoire.settings import default_settings_file, load_settings
+
+
+def test_shipped_4ws_settings_are_table_one():
+    s = load_settings(robot="4ws-5")
+    assert (s.initial_batch, s.batch_size, s.iterations) == (10_000, 1000, 1000)
+    assert (s.mutation_probability, s.mutation_sigma) == (0.25, 0.5)
+    assert (s.bin_size, s.eval_time, s.metric) == (0.04, 2.0, "circular")
+    assert s.evaluations == 1_010_000
+    assert default_settings_file("2ws-2") == config_dir() / "repertoire" / "4ws.yaml"
+
+
+def test_overrides_win_and_none_is_ignored():
+    s = load_settings(robot="2ws-3", bin_size=0.02, seed=None)
+    assert (s.robot, s.bin_size, s.seed) == ("2ws-3", 0.02, 0)
+
+
+def error_for(tmp_path, text, **overrides):
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as info:
+        load_settings(path, **overrides)
+    message = str(info.value)
+    assert message.startswith(str(path)) and "\n" not in message
+    return message
+
+
+BASE = (
+    "robot: 4ws-5\nmetric: circular\nbin_size: 0.04\neval_time: 2.0\n"
+    "initial_batch: 10\nbatch_size: 10\niterations: 1\n"
+)
+
+
+def test_invalid_yaml_names_the_line(tmp_path):
+    assert "line 2" in error_for(tmp_path, "robot: 4ws-5\n  metric: circular\n")
+
+
+def test_unknown_key_suggests_the_right_one(tmp_path):
+    assert "did you mean 'bin_size'" in error_for(tmp_path, BASE + "bin_sise: 0.02\n")
+
+
+def test_wrong_type_and_range(tmp_path):
+    assert "batch_size must be an integer" in error_for(tmp_path, BASE + "batch_size: 1.5\n")
+    assert "bin_size must be >= 0.0001" in error_for(tmp_path, BASE + "bin_size: -1\n")
+    assert "mutation_probability must be <= 1" in error_for(
+        tmp_path, BASE + "mutation_probability: 2\n"
+    )
+    assert "metric must be one of" in error_for(tmp_path, BASE + "metric: curvy\n")
+    assert "seed must be an integer" in error_for(tmp_path, BASE + "seed: true\n")
+
+
+def test_missing_key_and_wrong_top_level(tmp_path):
+    assert "missing setting 'iterations'" in error_for(
+        tmp_path, BASE.replace("iterations: 1\n", "")
+    )
+    assert "expected a mapping" in error_for(tmp_path, "- 1\n- 2\n")
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(ConfigError, match="no such settings file"):
+        load_settings(tmp_path / "nope.yaml")

@@ -1,0 +1,150 @@
+"""MAP-Elites: archive layout, the paper's mutation, determinism, checkpoints and resume."""
+
+import numpy as np
+import pytest
+from conftest import small_settings
+
+from offline_evolution.checkpoint import CheckpointError
+from offline_evolution.repertoire.archive import grid_layout, make_archive
+from offline_evolution.repertoire.emitter import PaperMutationEmitter
+from offline_evolution.repertoire.map_elites import (
+    Interrupted,
+    MapElites,
+    generate_repertoire,
+)
+from offline_evolution.repertoire.settings import load_settings
+
+
+def assert_same_repertoire(a, b):
+    for field in ("genes", "behaviour", "heading", "quality"):
+        np.testing.assert_array_equal(getattr(a, field), getattr(b, field))
+
+
+def test_grid_is_symmetric_with_a_cell_centred_on_the_origin():
+    layout = grid_layout(max_reach=0.4, bin_size=0.04)
+    assert layout["dims"] == [21, 21]
+    np.testing.assert_allclose(layout["low"], [-0.42, -0.42])
+    np.testing.assert_allclose(layout["high"], [0.42, 0.42])
+    archive = make_archive(layout, solution_dim=2, seed=0)
+    centre = archive.index_of(np.array([[0.0, 0.0], [0.019, -0.019]]))
+    assert centre[0] == centre[1] == archive.grid_to_int_index([[10, 10]])[0]
+    mirrored = archive.index_of(np.array([[0.11, 0.29], [-0.11, -0.29]]))
+    grid = archive.int_to_grid_index(mirrored)
+    assert tuple(grid[0] + grid[1]) == (20, 20)
+
+
+def test_a_cell_only_takes_a_strictly_better_primitive():
+    archive = make_archive(grid_layout(0.4, 0.04), solution_dim=1, seed=0)
+    where = np.array([[0.1, 0.1]])
+    archive.add(np.array([[0.1]]), np.array([0.5]), where, heading=np.array([0.0]))
+    archive.add(np.array([[0.2]]), np.array([0.5]), where, heading=np.array([0.0]))
+    assert archive.data("solution")[0, 0] == 0.1
+    archive.add(np.array([[0.3]]), np.array([0.6]), where, heading=np.array([0.0]))
+    assert archive.data("solution")[0, 0] == 0.3
+
+
+def test_paper_mutation_changes_a_quarter_of_the_genes_by_half_a_unit():
+    archive = make_archive(grid_layout(0.4, 0.04), solution_dim=5, seed=0)
+    archive.add(np.zeros((1, 5)), np.ones(1), np.zeros((1, 2)), heading=np.zeros(1))
+    emitter = PaperMutationEmitter(
+        archive, initial_batch=10, batch_size=40000, mutation_probability=0.25, sigma=0.5, seed=1
+    )
+    first = emitter.ask()
+    assert first.shape == (10, 5) and np.all(np.abs(first) <= 1)
+    mutants = emitter.ask()
+    assert mutants.shape == (40000, 5)
+    changed = mutants != 0.0
+    assert changed.mean() == pytest.approx(0.25, abs=0.01)
+    assert np.all(np.abs(mutants) <= 1.0)
+    # N(0, 0.5) clipped to [-1, 1]: inside, a normal truncated at 2 sd (sd 0.44 m).
+    inner = mutants[changed & (np.abs(mutants) < 1.0)]
+    assert np.std(inner) == pytest.approx(0.4398, abs=0.01)
+    assert np.mean(np.abs(mutants[changed]) == 1.0) == pytest.approx(0.0455, abs=0.01)
+
+
+def test_same_seed_same_repertoire_and_other_seed_differs(small_repertoire):
+    assert_same_repertoire(small_repertoire, generate_repertoire(small_settings()))
+    other = generate_repertoire(small_settings(seed=8))
+    assert not np.array_equal(
+        other.genes[: len(small_repertoire)], small_repertoire.genes[: len(other)]
+    )
+
+
+def test_resumed_run_equals_an_uninterrupted_run(tmp_path, small_repertoire):
+    ckpt = tmp_path / "run.checkpoint.npz"
+    polls = []
+
+    def stop_after_twelve():
+        polls.append(1)
+        return len(polls) == 13  # batch 13 = iteration 12
+
+    with pytest.raises(Interrupted) as info:
+        generate_repertoire(
+            small_settings(), checkpoint=ckpt, checkpoint_every=5, should_stop=stop_after_twelve
+        )
+    assert info.value.iteration == 12 and ckpt.exists()
+    seen = []
+    resumed = generate_repertoire(
+        small_settings(), checkpoint=ckpt, checkpoint_every=5, progress=seen.append
+    )
+    assert seen[0].resumed_from == 12 and seen[0].iteration == 13
+    assert resumed.algorithm["evaluations"] == small_settings().evaluations
+    assert_same_repertoire(resumed, small_repertoire)
+    assert not ckpt.exists()  # a finished run removes its checkpoint
+
+
+def test_resume_from_a_periodic_checkpoint_after_a_crash(tmp_path, small_repertoire):
+    ckpt = tmp_path / "run.ckpt.npz"
+    run = MapElites(small_settings())
+    for _ in range(10):
+        run.step()
+    run.save(ckpt)
+    for _ in range(3):
+        run.step()  # work after the last checkpoint is lost in a crash, then redone
+    resumed = generate_repertoire(small_settings(), checkpoint=ckpt)
+    assert_same_repertoire(resumed, small_repertoire)
+
+
+def test_checkpoint_of_another_run_is_refused(tmp_path):
+    ckpt = tmp_path / "c.npz"
+    run = MapElites(small_settings())
+    run.step()
+    run.save(ckpt)
+    with pytest.raises(CheckpointError, match="seed is 7 in the checkpoint but 9 now"):
+        generate_repertoire(small_settings(seed=9), checkpoint=ckpt)
+    ckpt.write_bytes(ckpt.read_bytes()[:100])
+    with pytest.raises(CheckpointError, match="not a usable checkpoint"):
+        generate_repertoire(small_settings(), checkpoint=ckpt)
+
+
+def test_repertoire_carries_its_settings_and_summary(small_repertoire):
+    r = small_repertoire
+    assert r.robot == "4ws-5" and r.metric == "circular" and r.seed == 7
+    assert r.eval_time == 2.0 and r.bin_size == 0.04
+    assert r.algorithm["evaluations"] == 400 + 25 * 100
+    assert [p.name for p in r.parameters] == [
+        "speed",
+        "angle_fl",
+        "angle_fr",
+        "angle_rl",
+        "angle_rr",
+    ]
+    s = r.summary()
+    assert s["count"] == len(r) > 50
+    assert s["qd_score"] == pytest.approx(r.quality.sum())
+    # One primitive per cell.
+    cells = np.floor((r.behaviour - np.array(r.archive["low"])) / r.bin_size).astype(int)
+    assert len({tuple(c) for c in cells}) == len(r)
+
+
+def test_full_table_one_budget_gives_a_high_quality_4ws5_repertoire():
+    # Paper Sec. IV-D: "MAP-Elites is able to evolve high-quality repertoires" (1.01M evals).
+    r = generate_repertoire(load_settings(robot="4ws-5", seed=1))
+    s = r.summary()
+    assert r.algorithm["evaluations"] == 1_010_000
+    assert s["mean_quality"] > 0.95
+    assert s["count"] > 230
+    # A 4WS robot moves as far left as right and as far backward as forward.
+    x, y = r.behaviour.T
+    assert abs(np.sum(y > 0) - np.sum(y < 0)) < 0.1 * len(r)
+    assert abs(np.sum(x > 0) - np.sum(x < 0)) < 0.1 * len(r)
