@@ -1,0 +1,1 @@
+"""Scripted experiments that reproduce the paper's comparisons (results go to ``docs/``)."""
