@@ -78,38 +78,36 @@ def _clip(value, bound):
 
 
 @nb.njit(cache=True)
-def axle_intersection(px1, py1, a1, px2, py2, a2):
+def axle_intersection(px1, py1, s1, c1, px2, py2, s2, c2):
     """Intersection of the axle lines of two wheels (body frame).
 
     A wheel at ``p`` steered by ``a`` rolls along ``(cos a, sin a)``; its axle line is
-    ``p + t (-sin a, cos a)``.
+    ``p + t (-sin a, cos a)``. The angles come as their sines ``s`` and cosines ``c``,
+    computed once per step by the caller.
 
     Returns:
         ``(exists, x, y)``; ``exists`` is False for parallel axles.
 
     """
-    den = math.sin(a2 - a1)  # cross product of the two unit axle directions
+    den = s2 * c1 - c2 * s1  # sin(a2 - a1): cross product of the unit axle directions
     if abs(den) < _PARALLEL_EPS:
         return False, 0.0, 0.0
-    dx = px2 - px1
-    dy = py2 - py1
-    t = (dx * math.cos(a2) + dy * math.sin(a2)) / den
-    return True, px1 - t * math.sin(a1), py1 + t * math.cos(a1)
+    t = ((px2 - px1) * c2 + (py2 - py1) * s2) / den
+    return True, px1 - t * s1, py1 + t * c1
 
 
 @nb.njit(cache=True)
-def _slips(icr_x, icr_y, px, py, angle, tan_max_slip):
-    """True if the wheel at ``(px, py)`` steered by ``angle`` slips more than allowed.
+def _slips(icr_x, icr_y, px, py, s, c, tan_max_slip):
+    """True if the wheel at ``(px, py)`` slips more than allowed.
 
-    The slip is the angle between the wheel's axle line and the line from the wheel to the
+    The wheel's steering angle ``a`` comes as ``s = sin a`` and ``c = cos a``. The slip is
+    the angle between the wheel's axle line ``(-s, c)`` and the line from the wheel to the
     ICR; comparing tangents avoids an atan2 in the hot loop.
     """
-    ux = -math.sin(angle)
-    uy = math.cos(angle)
     wx = icr_x - px
     wy = icr_y - py
-    cross = abs(ux * wy - uy * wx)
-    dot = abs(ux * wx + uy * wy)
+    cross = abs(-s * wy - c * wx)
+    dot = abs(-s * wx + c * wy)
     return cross > tan_max_slip * dot
 
 
@@ -136,8 +134,12 @@ def body_motion(a_fl, a_fr, a_rl, a_rr, distance, lim):
         # Crab motion: translate along the common wheel direction, heading unchanged.
         return True, distance * math.cos(a_mean), distance * math.sin(a_mean), 0.0
 
-    ok_l, lx, ly = axle_intersection(hx, hy, a_fl, -hx, hy, a_rl)
-    ok_r, rx, ry = axle_intersection(hx, -hy, a_fr, -hx, -hy, a_rr)
+    s_fl, c_fl = math.sin(a_fl), math.cos(a_fl)
+    s_fr, c_fr = math.sin(a_fr), math.cos(a_fr)
+    s_rl, c_rl = math.sin(a_rl), math.cos(a_rl)
+    s_rr, c_rr = math.sin(a_rr), math.cos(a_rr)
+    ok_l, lx, ly = axle_intersection(hx, hy, s_fl, c_fl, -hx, hy, s_rl, c_rl)
+    ok_r, rx, ry = axle_intersection(hx, -hy, s_fr, c_fr, -hx, -hy, s_rr, c_rr)
     if ok_l and ok_r:
         icr_x = 0.5 * (lx + rx)
         icr_y = 0.5 * (ly + ry)
@@ -160,20 +162,28 @@ def body_motion(a_fl, a_fr, a_rl, a_rr, distance, lim):
     # One shared wheel speed cannot spin the body about a point inside the wheel rectangle.
     if abs(icr_x) <= hx and abs(icr_y) <= hy:
         return False, 0.0, 0.0, 0.0
+    t = lim.tan_max_slip
     if (
-        _slips(icr_x, icr_y, hx, hy, a_fl, lim.tan_max_slip)
-        or _slips(icr_x, icr_y, hx, -hy, a_fr, lim.tan_max_slip)
-        or _slips(icr_x, icr_y, -hx, hy, a_rl, lim.tan_max_slip)
-        or _slips(icr_x, icr_y, -hx, -hy, a_rr, lim.tan_max_slip)
+        _slips(icr_x, icr_y, hx, hy, s_fl, c_fl, t)
+        or _slips(icr_x, icr_y, hx, -hy, s_fr, c_fr, t)
+        or _slips(icr_x, icr_y, -hx, hy, s_rl, c_rl, t)
+        or _slips(icr_x, icr_y, -hx, -hy, s_rr, c_rr, t)
     ):
         return False, 0.0, 0.0, 0.0
 
     # Sense of rotation: rolling forward, each wheel moves along (cos a, sin a); a rotation
     # omega about the ICR moves a wheel at p with omega * z x (p - icr). Summing the
     # projections over the wheels decides the sign robustly.
-    sense = 0.0
-    for px, py, a in ((hx, hy, a_fl), (hx, -hy, a_fr), (-hx, hy, a_rl), (-hx, -hy, a_rr)):
-        sense += math.cos(a) * (icr_y - py) - math.sin(a) * (icr_x - px)
+    sense = (
+        c_fl * (icr_y - hy)
+        - s_fl * (icr_x - hx)
+        + c_fr * (icr_y + hy)
+        - s_fr * (icr_x - hx)
+        + c_rl * (icr_y - hy)
+        - s_rl * (icr_x + hx)
+        + c_rr * (icr_y + hy)
+        - s_rr * (icr_x + hx)
+    )
     radius = math.hypot(icr_x, icr_y)
     dheading = distance / radius
     if sense < 0.0:
@@ -292,14 +302,14 @@ def run_primitives(commands, n_steps, lim):
     """
     n = commands.shape[0]
     out = np.empty((n, 4))
+    state = np.zeros((n, STATE_SIZE))
     no_walls = np.empty((0, 5))
     for i in nb.prange(n):
-        state = np.zeros((1, STATE_SIZE))
         path = 0.0
         for _ in range(n_steps):
-            path += step_robot(state, 0, commands[i], lim, no_walls)
-        out[i, 0] = state[0, X]
-        out[i, 1] = state[0, Y]
-        out[i, 2] = state[0, HEADING]
+            path += step_robot(state, i, commands[i], lim, no_walls)
+        out[i, 0] = state[i, X]
+        out[i, 1] = state[i, Y]
+        out[i, 2] = state[i, HEADING]
         out[i, 3] = path
     return out
