@@ -107,26 +107,23 @@ def plot_repertoire_panels(
 ) -> None:
     """Several repertoires side by side on one colour scale (like Fig. 8, top)."""
     n = len(repertoires)
-    fig, axes = plt.subplots(1, n, figsize=(3.6 * n, 4.2), squeeze=False)
+    fig, axes = plt.subplots(
+        1, n, figsize=(3.3 * n + 1.0, 3.9), squeeze=False, layout="constrained"
+    )
     norm = quality_norm(repertoires[0])
     for k, (ax, r) in enumerate(zip(axes[0], repertoires, strict=True)):
         draw_repertoire(ax, r, norm)
-        ax.set_title(titles[k] if titles else r.robot)
-        ax.set_xlabel("x (m)")
         s = r.summary()
-        ax.text(
-            0.5,
-            -0.2,
-            f"{s['count']} primitives, q = {s['mean_quality']:.3f}",
-            transform=ax.transAxes,
-            ha="center",
-            fontsize=9,
+        name = titles[k] if titles else r.robot
+        ax.set_title(
+            f"{name}\n{s['count']} primitives, mean quality {s['mean_quality']:.3f}", fontsize=10
         )
+        ax.set_xlabel("x (m)")
     axes[0][0].set_ylabel("y (m)")
     fig.colorbar(
         plt.cm.ScalarMappable(norm=norm, cmap="viridis"),
         ax=list(axes[0]),
-        shrink=0.8,
+        shrink=0.9,
         label=f"quality ({repertoires[0].metric})",
     )
     save_figure(fig, path)
