@@ -24,6 +24,15 @@ class CheckpointError(ValueError):
     """A checkpoint cannot be used; the message names the file and the reason."""
 
 
+class Interrupted(Exception):
+    """A run was asked to stop; finished work is in the checkpoint."""
+
+    def __init__(self, iteration: int, checkpoint: str | None) -> None:
+        super().__init__(f"stopped after iteration {iteration}")
+        self.iteration = iteration
+        self.checkpoint = checkpoint
+
+
 def save_checkpoint(path: str | os.PathLike, header: dict, arrays: dict[str, np.ndarray]):
     """Write ``header`` (JSON-safe) and ``arrays`` to ``path`` atomically."""
     buf = io.BytesIO()

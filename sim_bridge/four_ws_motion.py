@@ -20,6 +20,7 @@ import numba as nb
 import numpy as np
 
 from evorbc_ros.robots.four_ws import FourWSGeometry
+from sim_bridge.geometry import clearance
 
 STATE_SIZE = 8
 X, Y, HEADING, SPEED, ANGLE_FL, ANGLE_FR, ANGLE_RL, ANGLE_RR = range(STATE_SIZE)
@@ -214,33 +215,7 @@ def apply_rate_limits(state, i, command, lim):
 
 
 @nb.njit(cache=True)
-def segment_clearance(px, py, walls):
-    """Smallest distance from ``(px, py)`` to the surface of any wall (m).
-
-    Args:
-        walls: ``(m, 5)`` rows ``(x1, y1, x2, y2, half_thickness)`` in the world frame.
-
-    """
-    best = np.inf
-    for k in range(walls.shape[0]):
-        x1 = walls[k, 0]
-        y1 = walls[k, 1]
-        ex = walls[k, 2] - x1
-        ey = walls[k, 3] - y1
-        qx = px - x1
-        qy = py - y1
-        length2 = ex * ex + ey * ey
-        t = 0.0
-        if length2 > 0.0:
-            t = min(max((qx * ex + qy * ey) / length2, 0.0), 1.0)
-        d = math.hypot(qx - t * ex, qy - t * ey) - walls[k, 4]
-        if d < best:
-            best = d
-    return best
-
-
-@nb.njit(cache=True)
-def step_robot(state, i, command, lim, walls):
+def step_robot(state, i, command, lim, boxes, candidates):
     """Advance robot ``i`` by one control step of ``lim.dt`` seconds.
 
     Rate limits apply first; the body then moves with the limited speed and wheel angles.
@@ -252,11 +227,12 @@ def step_robot(state, i, command, lim, walls):
         i: row of the robot to step.
         command: ``(5,)`` wheel command.
         lim: :class:`MotionLimits`.
-        walls: ``(m, 5)`` wall segments (may have ``m = 0``).
+        boxes: ``(m, 6)`` wall boxes (see :mod:`sim_bridge.geometry`), may be empty.
+        candidates: rows of ``boxes`` to test; they must include every wall within
+            ``footprint_radius`` plus one step (0.02 m) of the robot.
 
     Returns:
         Distance the body centre travelled this step (m, >= 0).
-
     """
     apply_rate_limits(state, i, command, lim)
     distance = state[i, SPEED] * lim.dt
@@ -276,7 +252,7 @@ def step_robot(state, i, command, lim, walls):
     nx = state[i, X] + c * dx - s * dy
     ny = state[i, Y] + s * dx + c * dy
     state[i, HEADING] = heading + dheading
-    if walls.shape[0] > 0 and segment_clearance(nx, ny, walls) < lim.footprint_radius:
+    if candidates.shape[0] > 0 and clearance(nx, ny, boxes, candidates) < lim.footprint_radius:
         return 0.0
     state[i, X] = nx
     state[i, Y] = ny
@@ -303,11 +279,12 @@ def run_primitives(commands, n_steps, lim):
     n = commands.shape[0]
     out = np.empty((n, 4))
     state = np.zeros((n, STATE_SIZE))
-    no_walls = np.empty((0, 5))
+    no_boxes = np.empty((0, 6))
+    no_candidates = np.empty(0, dtype=np.int64)
     for i in nb.prange(n):
         path = 0.0
         for _ in range(n_steps):
-            path += step_robot(state, i, commands[i], lim, no_walls)
+            path += step_robot(state, i, commands[i], lim, no_boxes, no_candidates)
         out[i, 0] = state[i, X]
         out[i, 1] = state[i, Y]
         out[i, 2] = state[i, HEADING]

@@ -106,12 +106,15 @@ def _line_angle_difference(a: float, b: float) -> float:
 
 
 def _wall_distance(px: float, py: float, wall) -> float:
-    """Distance from a point to a wall's centre segment."""
-    x1, y1, x2, y2 = wall[:4]
-    dx, dy = x2 - x1, y2 - y1
-    length2 = dx * dx + dy * dy
-    t = 0.0 if length2 == 0.0 else _clip(((px - x1) * dx + (py - y1) * dy) / length2, 0.0, 1.0)
-    return math.hypot(px - (x1 + t * dx), py - (y1 + t * dy))
+    """Distance from a point to a wall: a box of the segment's length and the wall's
+    thickness, centred on the segment (0 inside it)."""
+    x1, y1, x2, y2, thickness = wall[:5]
+    length = math.hypot(x2 - x1, y2 - y1)
+    ux, uy = (x2 - x1) / length, (y2 - y1) / length
+    mx, my = px - (x1 + x2) / 2.0, py - (y1 + y2) / 2.0
+    along = abs(mx * ux + my * uy) - length / 2.0
+    across = abs(-mx * uy + my * ux) - thickness / 2.0
+    return math.hypot(max(along, 0.0), max(across, 0.0))
 
 
 def body_motion(angles: Sequence[float], s: float, margins: Margins | None = None):
@@ -201,7 +204,7 @@ def reference_step(state: State, command: Sequence[float], walls=(), margins=Non
     distance = abs(s) if moved else 0.0
     blocked = False
     for wall in walls:
-        clearance = FOOTPRINT_RADIUS + wall[4] / 2.0
+        clearance = FOOTPRINT_RADIUS
         d = _wall_distance(x, y, wall)
         m.wall = min(m.wall, abs(d - clearance))
         blocked = blocked or d < clearance

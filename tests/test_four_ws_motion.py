@@ -17,11 +17,12 @@ from sim_bridge.four_ws_motion import (
     run_primitives,
     step_robot,
 )
+from sim_bridge.geometry import wall_boxes
 
 G = FourWSGeometry()
 LIM = motion_limits(G)
 HX, HY = G.wheel_x, G.wheel_y
-NO_WALLS = np.empty((0, 5))
+NO_WALLS = (np.empty((0, 6)), np.empty(0, dtype=np.int64))
 DEG = math.pi / 180.0
 
 
@@ -37,7 +38,7 @@ def moving_state(angles, speed, pose=(0.0, 0.0, 0.0)):
 def steps(state, command, n, walls=NO_WALLS):
     travelled = 0.0
     for _ in range(n):
-        travelled += step_robot(state, 0, command, LIM, walls)
+        travelled += step_robot(state, 0, command, LIM, *walls)
     return travelled
 
 
@@ -133,22 +134,23 @@ def test_icr_inside_the_wheel_rectangle_means_no_motion():
 def test_rate_limits_on_wheel_angles_and_speed():
     state = np.zeros((1, STATE_SIZE))
     cmd = np.array([5.0, 45 * DEG, -45 * DEG, 30 * DEG, -10 * DEG])  # speed beyond range
-    step_robot(state, 0, cmd, LIM, NO_WALLS)
+    step_robot(state, 0, cmd, LIM, *NO_WALLS)
     np.testing.assert_allclose(state[0, SPEED], 0.04, atol=1e-15)
     np.testing.assert_allclose(state[0, 4:], np.array([9, -9, 9, -9]) * DEG, atol=1e-15)
     for _ in range(3):
-        step_robot(state, 0, cmd, LIM, NO_WALLS)
+        step_robot(state, 0, cmd, LIM, *NO_WALLS)
     np.testing.assert_allclose(state[0, 4:], np.array([36, -36, 30, -10]) * DEG, atol=1e-14)
-    step_robot(state, 0, cmd, LIM, NO_WALLS)
+    step_robot(state, 0, cmd, LIM, *NO_WALLS)
     np.testing.assert_allclose(state[0, 4:], np.array([45, -45, 30, -10]) * DEG, atol=1e-14)
     np.testing.assert_allclose(state[0, SPEED], 0.2, atol=1e-15)  # clipped to 0.2 m/s
     cmd = np.array([-0.2, 0.0, 0.0, 0.0, 0.0])
-    step_robot(state, 0, cmd, LIM, NO_WALLS)
+    step_robot(state, 0, cmd, LIM, *NO_WALLS)
     np.testing.assert_allclose(state[0, SPEED], 0.16, atol=1e-15)
 
 
 def test_wall_contact_stops_the_body_but_keeps_the_heading_change():
-    wall = np.array([[0.2, -1.0, 0.2, 1.0, 0.005]])  # x = 0.2 m, 1 cm thick
+    # A wall along x = 0.2 m, 1 cm thick.
+    wall = (wall_boxes(np.array([[0.2, -1.0, 0.2, 1.0]]), 0.01), np.array([0]))
     state, cmd = moving_state([0, 0, 0, 0], 0.1, pose=(0.13, 0.0, 0.0))
     assert steps(state, cmd, 1, wall) == pytest.approx(0.01)  # 0.055 m clearance: free
     assert steps(state, cmd, 1, wall) == 0.0  # would leave 0.045 m < 0.05 m: blocked

@@ -16,6 +16,7 @@ from reference_four_ws import Margins, State, reference_primitive, reference_ste
 
 from evorbc_ros.robots.four_ws import FourWSGeometry
 from sim_bridge.four_ws_motion import STATE_SIZE, motion_limits, run_primitives, step_robot
+from sim_bridge.geometry import wall_boxes
 
 TOL = 1e-9  # m and rad
 MARGIN = 1e-9  # keep inputs this far from every threshold
@@ -23,7 +24,7 @@ STEPS = 20  # T = 2 s
 A = math.radians(45.0)
 V = 0.20
 LIM = motion_limits(FourWSGeometry())
-NO_WALLS = np.zeros((0, 5))
+NO_WALLS = np.zeros((0, 6))
 
 BOX = [  # a 0.4 m square around the start, walls 0.02 m thick
     (-0.2, -0.2, 0.2, -0.2, 0.02),
@@ -34,11 +35,12 @@ BOX = [  # a 0.4 m square around the start, walls 0.02 m thick
 WALL_AHEAD = [(0.12, -0.06, 0.12, 0.06, 0.01)]  # short, so the robot can also pass its ends
 
 
-def _project_walls(walls) -> np.ndarray:
-    """Reference walls (full thickness) as the project's array (half thickness)."""
+def _project_walls(walls) -> tuple[np.ndarray, np.ndarray]:
+    """Reference walls ``(x1, y1, x2, y2, thickness)`` as the project's boxes and candidates."""
     if not walls:
-        return NO_WALLS
-    return np.array([(x1, y1, x2, y2, t / 2.0) for x1, y1, x2, y2, t in walls], dtype=float)
+        return NO_WALLS, np.empty(0, dtype=np.int64)
+    boxes = np.concatenate([wall_boxes(np.array([w[:4]]), w[4]) for w in walls])
+    return boxes, np.arange(len(walls), dtype=np.int64)
 
 
 def _row(state: State) -> np.ndarray:
@@ -225,7 +227,7 @@ def _run_both(seq: np.ndarray, walls) -> tuple[str | None, int, int]:
         if walls and dist == 0.0 and reference_step(before, tuple(command))[1] > 0.0:
             blocked += 1
         moving += dist > 0.0
-        got = step_robot(arr, 0, np.ascontiguousarray(command, dtype=float), LIM, pwalls)
+        got = step_robot(arr, 0, np.ascontiguousarray(command, dtype=float), LIM, *pwalls)
         want = _row(ref)
         if abs(got - dist) > TOL or np.max(np.abs(arr[0] - want)) > TOL:
             return (

@@ -20,6 +20,7 @@ from evorbc_ros.config import ConfigError
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.checkpoint import (
     CheckpointError,
+    Interrupted,
     load_checkpoint,
     save_checkpoint,
     settings_mismatch,
@@ -51,15 +52,6 @@ class Progress:
     qd_score: float
     elapsed: float  # s of wall time in this process
     resumed_from: int | None = None  # iteration the run resumed from, if any
-
-
-class Interrupted(Exception):
-    """The run was asked to stop; finished work is in the checkpoint."""
-
-    def __init__(self, iteration: int, checkpoint: str | None) -> None:
-        super().__init__(f"stopped after iteration {iteration}")
-        self.iteration = iteration
-        self.checkpoint = checkpoint
 
 
 class MapElites:

@@ -17,7 +17,7 @@ class FourWSRobot:
         self.type: FourWSType = robot_type(type_name)
         self.name = self.type.name
         self.geometry = geometry or FourWSGeometry()
-        self._limits = motion_limits(self.geometry)
+        self.limits = motion_limits(self.geometry)
         self.control_period = self.geometry.control_period
 
     @property
@@ -39,5 +39,5 @@ class FourWSRobot:
             )
         steps = control_steps(eval_time, self.geometry.control_period)
         commands = np.ascontiguousarray(self.type.commands(genes, self.geometry))
-        out = run_primitives(commands, steps, self._limits)
+        out = run_primitives(commands, steps, self.limits)
         return PrimitiveOutcome(x=out[:, 0], y=out[:, 1], heading=out[:, 2], path=out[:, 3])

@@ -1,0 +1,327 @@
+"""Feed-forward NEAT networks as plain data, compiled to arrays and evaluated onboard.
+
+A :class:`NetworkSpec` is what an arbitrator file stores: nodes (bias, response,
+activation, aggregation), connections (source, target, weight, enabled) and the input and
+output keys, with neat-python's conventions (inputs have keys -1, -2, ...; outputs 0, 1,
+...). :meth:`NetworkSpec.compile` turns it into flat arrays in evaluation order, the form
+both this module's pure-Python :meth:`CompiledNetwork.activate` (onboard, 10 Hz) and the
+numba kernels of the offline evolution run.
+
+Semantics follow neat-python's ``FeedForwardNetwork``: only nodes that some output
+depends on are evaluated, each as ``activation(bias + response * aggregation(inputs))``
+over its enabled incoming connections in file order; a needed node with no enabled input
+outputs ``activation(bias + response * aggregation([]))``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def _clamp(z: float, lo: float, hi: float) -> float:
+    return max(lo, min(hi, z))
+
+
+def _inv(z: float) -> float:
+    return 1.0 / z if z != 0.0 else 0.0
+
+
+# neat-python's activation functions (same definitions, clamps and constants). The order
+# fixes the integer ids the compiled kernels use.
+ACTIVATIONS = {
+    "sigmoid": lambda z: 1.0 / (1.0 + math.exp(-_clamp(5.0 * z, -60.0, 60.0))),
+    "tanh": lambda z: math.tanh(_clamp(2.5 * z, -60.0, 60.0)),
+    "sin": lambda z: math.sin(_clamp(5.0 * z, -60.0, 60.0)),
+    "gauss": lambda z: math.exp(-5.0 * _clamp(z, -3.4, 3.4) ** 2),
+    "relu": lambda z: z if z > 0.0 else 0.0,
+    "elu": lambda z: z if z > 0.0 else math.exp(z) - 1.0,
+    "lelu": lambda z: z if z > 0.0 else 0.005 * z,
+    "selu": lambda z: (
+        1.0507009873554804934193349852946 * z
+        if z > 0.0
+        else 1.0507009873554804934193349852946
+        * 1.6732632423543772848170429916717
+        * (math.exp(z) - 1.0)
+    ),
+    "softplus": lambda z: 0.2 * math.log(1.0 + math.exp(_clamp(5.0 * z, -60.0, 60.0))),
+    "identity": lambda z: z,
+    "clamped": lambda z: _clamp(z, -1.0, 1.0),
+    "inv": _inv,
+    "log": lambda z: math.log(max(1e-7, z)),
+    "exp": lambda z: math.exp(_clamp(z, -60.0, 60.0)),
+    "abs": abs,
+    "hat": lambda z: max(0.0, 1.0 - abs(z)),
+    "square": lambda z: z * z,
+    "cube": lambda z: z * z * z,
+}
+ACTIVATION_IDS = {name: k for k, name in enumerate(ACTIVATIONS)}
+
+
+def _median(values: list[float]) -> float:
+    n = len(values)
+    if n <= 2:
+        return sum(values) / n
+    v = sorted(values)
+    return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2.0
+
+
+# neat-python's aggregations, with its values for a node without inputs.
+AGGREGATIONS = {
+    "sum": lambda x: sum(x, 0.0),
+    "product": lambda x: math.prod(x, start=1.0),
+    "max": lambda x: max(x) if x else 0.0,
+    "min": lambda x: min(x) if x else 0.0,
+    "maxabs": lambda x: max(x, key=abs) if x else 0.0,
+    "mean": lambda x: sum(x, 0.0) / len(x) if x else 0.0,
+    "median": lambda x: _median(x) if x else 0.0,
+}
+AGGREGATION_IDS = {name: k for k, name in enumerate(AGGREGATIONS)}
+
+
+class NetworkError(ValueError):
+    """A network description is inconsistent; the message says what is wrong."""
+
+
+@dataclass(frozen=True)
+class NodeSpec:
+    """A hidden or output node."""
+
+    key: int
+    bias: float
+    response: float
+    activation: str
+    aggregation: str
+
+
+@dataclass(frozen=True)
+class ConnectionSpec:
+    """A connection gene; disabled connections are kept but not evaluated."""
+
+    source: int
+    target: int
+    weight: float
+    enabled: bool = True
+
+
+@dataclass(frozen=True)
+class NetworkSpec:
+    """A feed-forward network in neat-python's terms."""
+
+    input_keys: tuple[int, ...]
+    output_keys: tuple[int, ...]
+    nodes: tuple[NodeSpec, ...]
+    connections: tuple[ConnectionSpec, ...]
+
+    def to_dict(self) -> dict:
+        """Plain-data form used in arbitrator files."""
+        return {
+            "inputs": list(self.input_keys),
+            "outputs": list(self.output_keys),
+            "nodes": [
+                {
+                    "key": n.key,
+                    "bias": n.bias,
+                    "response": n.response,
+                    "activation": n.activation,
+                    "aggregation": n.aggregation,
+                }
+                for n in self.nodes
+            ],
+            "connections": [
+                {"source": c.source, "target": c.target, "weight": c.weight, "enabled": c.enabled}
+                for c in self.connections
+            ],
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> NetworkSpec:
+        """Build from :meth:`to_dict`'s form; raises :class:`NetworkError` if malformed."""
+        try:
+            spec = cls(
+                input_keys=tuple(_int(k, "inputs") for k in data["inputs"]),
+                output_keys=tuple(_int(k, "outputs") for k in data["outputs"]),
+                nodes=tuple(
+                    NodeSpec(
+                        _int(n["key"], "nodes.key"),
+                        _num(n["bias"], "bias"),
+                        _num(n["response"], "response"),
+                        str(n["activation"]),
+                        str(n["aggregation"]),
+                    )
+                    for n in data["nodes"]
+                ),
+                connections=tuple(
+                    ConnectionSpec(
+                        _int(c["source"], "connections.source"),
+                        _int(c["target"], "connections.target"),
+                        _num(c["weight"], "weight"),
+                        _bool(c["enabled"]),
+                    )
+                    for c in data["connections"]
+                ),
+            )
+        except KeyError as e:
+            raise NetworkError(f"missing key {e.args[0]!r} in the network") from None
+        except TypeError as e:
+            raise NetworkError(f"malformed network ({e})") from None
+        spec.compile()  # validates structure
+        return spec
+
+    def compile(self) -> CompiledNetwork:
+        """Arrays in evaluation order (see :class:`CompiledNetwork`).
+
+        Raises:
+            NetworkError: unknown activation/aggregation, duplicate or missing nodes,
+                connections to unknown nodes, or a cycle among the needed nodes.
+        """
+        return _compile(self)
+
+    def n_connections(self, enabled_only: bool = True) -> int:
+        """Number of (enabled) connections."""
+        return sum(1 for c in self.connections if c.enabled or not enabled_only)
+
+
+@dataclass(frozen=True)
+class CompiledNetwork:
+    """A network flattened for evaluation.
+
+    Value slots: inputs first (in ``input_keys`` order), then outputs (``output_keys``
+    order), then the needed hidden nodes. Node ``k`` of the evaluation order writes slot
+    ``node_slot[k]`` from links ``link_start[k]:link_start[k + 1]`` (source slot, weight).
+    """
+
+    n_inputs: int
+    n_outputs: int
+    n_slots: int
+    node_slot: np.ndarray  # (n_eval,) int64
+    bias: np.ndarray  # (n_eval,)
+    response: np.ndarray  # (n_eval,)
+    activation: np.ndarray  # (n_eval,) int64 ids into ACTIVATIONS
+    aggregation: np.ndarray  # (n_eval,) int64 ids into AGGREGATIONS
+    link_start: np.ndarray  # (n_eval + 1,) int64
+    link_source: np.ndarray  # (n_links,) int64 slots
+    link_weight: np.ndarray  # (n_links,)
+
+    def activate(self, inputs) -> np.ndarray:
+        """Evaluate the network on ``inputs`` (length ``n_inputs``); returns the outputs."""
+        values = [0.0] * self.n_slots
+        if len(inputs) != self.n_inputs:
+            raise ValueError(f"expected {self.n_inputs} inputs, got {len(inputs)}")
+        values[: self.n_inputs] = [float(v) for v in inputs]
+        activations = list(ACTIVATIONS.values())
+        aggregations = list(AGGREGATIONS.values())
+        for k in range(len(self.node_slot)):
+            lo, hi = self.link_start[k], self.link_start[k + 1]
+            terms = [values[self.link_source[j]] * self.link_weight[j] for j in range(lo, hi)]
+            s = aggregations[self.aggregation[k]](terms)
+            values[self.node_slot[k]] = activations[self.activation[k]](
+                self.bias[k] + self.response[k] * s
+            )
+        return np.array(values[self.n_inputs : self.n_inputs + self.n_outputs])
+
+
+def _num(value, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise NetworkError(f"{what} must be a finite number, got {value!r}")
+    return float(value)
+
+
+def _int(value, what: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise NetworkError(f"{what} must be an integer, got {value!r}")
+    return value
+
+
+def _bool(value) -> bool:
+    if not isinstance(value, bool):
+        raise NetworkError(f"connections.enabled must be true or false, got {value!r}")
+    return value
+
+
+def _needed_nodes(inputs: set[int], outputs: list[int], edges: list[tuple[int, int]]) -> set:
+    """Nodes some output depends on (outputs included, inputs excluded)."""
+    needed = set(outputs)
+    frontier = set(outputs)
+    while frontier:
+        sources = {a for a, b in edges if b in frontier and a not in needed and a not in inputs}
+        needed |= sources
+        frontier = sources
+    return needed
+
+
+def _compile(spec: NetworkSpec) -> CompiledNetwork:
+    nodes = {}
+    for n in spec.nodes:
+        if n.key in nodes:
+            raise NetworkError(f"node {n.key} is defined twice")
+        if n.activation not in ACTIVATION_IDS:
+            raise NetworkError(
+                f"node {n.key}: unknown activation {n.activation!r}; "
+                f"supported: {', '.join(ACTIVATIONS)}"
+            )
+        if n.aggregation not in AGGREGATION_IDS:
+            raise NetworkError(
+                f"node {n.key}: unknown aggregation {n.aggregation!r}; "
+                f"supported: {', '.join(AGGREGATIONS)}"
+            )
+        nodes[n.key] = n
+    inputs = list(spec.input_keys)
+    outputs = list(spec.output_keys)
+    if not inputs or not outputs:
+        raise NetworkError("a network needs inputs and outputs")
+    if len(set(inputs)) != len(inputs) or len(set(outputs)) != len(outputs):
+        raise NetworkError("input and output keys must be unique")
+    if set(inputs) & set(nodes):
+        raise NetworkError("input keys must not be node keys")
+    missing = [k for k in outputs if k not in nodes]
+    if missing:
+        raise NetworkError(f"output node {missing[0]} has no node definition")
+    input_set = set(inputs)
+    for c in spec.connections:
+        if c.source not in nodes and c.source not in input_set:
+            raise NetworkError(f"connection {c.source}->{c.target} starts at an unknown node")
+        if c.target not in nodes:
+            raise NetworkError(f"connection {c.source}->{c.target} ends at an unknown node")
+    enabled = [c for c in spec.connections if c.enabled]
+    edges = [(c.source, c.target) for c in enabled]
+    needed = _needed_nodes(input_set, outputs, edges)
+
+    # Topological order of the needed nodes (Kahn), ready nodes by key for determinism:
+    # in a DAG every order gives the same values.
+    preds = {n: {a for a, b in edges if b == n and a in needed} for n in needed}
+    order, done = [], set()
+    while len(order) < len(needed):
+        ready = sorted(n for n in needed if n not in done and preds[n] <= done)
+        if not ready:
+            raise NetworkError("the network has a cycle; only feed-forward networks run here")
+        order.extend(ready)
+        done.update(ready)
+
+    slots = {k: i for i, k in enumerate(inputs)}
+    slots.update({k: len(inputs) + i for i, k in enumerate(outputs)})
+    for k in order:
+        slots.setdefault(k, len(slots))
+    link_start, link_source, link_weight = [0], [], []
+    for k in order:
+        # Links in file order: the same summation order as neat-python.
+        for c in enabled:
+            if c.target == k and (c.source in needed or c.source in input_set):
+                link_source.append(slots[c.source])
+                link_weight.append(c.weight)
+        link_start.append(len(link_source))
+    return CompiledNetwork(
+        n_inputs=len(inputs),
+        n_outputs=len(outputs),
+        n_slots=len(slots),
+        node_slot=np.array([slots[k] for k in order], dtype=np.int64),
+        bias=np.array([nodes[k].bias for k in order], dtype=np.float64),
+        response=np.array([nodes[k].response for k in order], dtype=np.float64),
+        activation=np.array([ACTIVATION_IDS[nodes[k].activation] for k in order], np.int64),
+        aggregation=np.array([AGGREGATION_IDS[nodes[k].aggregation] for k in order], np.int64),
+        link_start=np.array(link_start, dtype=np.int64),
+        link_source=np.array(link_source, dtype=np.int64),
+        link_weight=np.array(link_weight, dtype=np.float64),
+    )

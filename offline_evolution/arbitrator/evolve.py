@@ -1,0 +1,330 @@
+"""Arbitrator evolution (EvoRBC) and the standard-NEAT baseline on the maze task.
+
+One generation: build each genome's network, run every genome in every maze in one batched
+kernel call (:mod:`offline_evolution.maze_task.kernel`), assign the mean eq. 5 fitness,
+then let neat-python reproduce and speciate. Start poses are new every generation and the
+same for every genome of a generation, drawn from a generator seeded by ``(seed,
+generation)``.
+
+Runs are seeded and deterministic, checkpoint every few generations as JSON (see
+:mod:`offline_evolution.arbitrator.neat_state`) and resume to exactly the result of an
+uninterrupted run.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import neat
+import numpy as np
+
+from evorbc_ros.arbitrator import ArbitratorFile
+from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.network import ConnectionSpec, NetworkSpec, NodeSpec
+from evorbc_ros.repertoire import Repertoire
+from offline_evolution.arbitrator.compiled import pack_networks
+from offline_evolution.arbitrator.neat_config import load_neat_config
+from offline_evolution.arbitrator.neat_state import (
+    genome_to_dict,
+    population_from_dict,
+    population_to_dict,
+)
+from offline_evolution.checkpoint import CheckpointError, Interrupted, settings_mismatch
+from offline_evolution.maze_task.task import (
+    MazeTask,
+    MazeTaskSettings,
+    evorbc_controller,
+    standard_controller,
+)
+
+CHECKPOINT_KIND = "evorbc-neat-checkpoint"
+#: Extra generations that give standard NEAT EvoRBC's budget: the 4WS repertoire costs
+#: about 2M simulated seconds, 25 generations of 150 x 5 x 120 s (paper Sec. IV-C).
+EQUAL_BUDGET_GENERATIONS = {"4ws": 25, "hexapod": 455}
+
+
+@dataclass(frozen=True)
+class EvolutionSettings:
+    """Everything that determines an evolution run's result."""
+
+    kind: str  # "evorbc" or "standard"
+    robot: str
+    generations: int
+    seed: int
+    neat_file: str
+    neat_sha256: str  # the NEAT settings' contents, so an edited file cannot resume
+    task: dict
+    mapping: str | None = None
+    repertoire_fingerprint: str | None = None
+
+    def as_dict(self) -> dict:
+        """Plain-data form (checkpoints and arbitrator files)."""
+        return dataclasses.asdict(self)
+
+
+@dataclass(frozen=True)
+class GenerationStats:
+    """Figures of one evaluated generation."""
+
+    generation: int
+    best: float  # highest fitness this generation
+    mean: float
+    best_so_far: float
+    species: int
+    seconds: float  # wall time of the whole generation
+    evaluation_seconds: float  # of which the batched simulation
+    best_reached: int  # mazes the generation's best genome reached
+
+    def as_dict(self) -> dict:
+        """Plain-data form."""
+        return dataclasses.asdict(self)
+
+
+@dataclass
+class EvolutionResult:
+    """The outcome: the best genome ever seen and the per-generation history."""
+
+    settings: EvolutionSettings
+    best_network: NetworkSpec
+    best_fitness: float
+    best_generation: int
+    history: list[GenerationStats]
+    seconds: float
+
+
+def network_spec(genome, config: neat.Config) -> NetworkSpec:
+    """A neat-python genome as a :class:`NetworkSpec` (genes kept in their order)."""
+    gc = config.genome_config
+    return NetworkSpec(
+        input_keys=tuple(gc.input_keys),
+        output_keys=tuple(gc.output_keys),
+        nodes=tuple(
+            NodeSpec(k, float(n.bias), float(n.response), n.activation, n.aggregation)
+            for k, n in genome.nodes.items()
+        ),
+        connections=tuple(
+            ConnectionSpec(k[0], k[1], float(c.weight), bool(c.enabled))
+            for k, c in genome.connections.items()
+        ),
+    )
+
+
+def file_sha256(path: str | os.PathLike) -> str:
+    """SHA-256 of a file's bytes."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+class Evolution:
+    """One NEAT run on the maze task."""
+
+    def __init__(self, settings: EvolutionSettings, repertoire: Repertoire | None = None):
+        self.settings = settings
+        self.task = MazeTask(MazeTaskSettings(**settings.task), settings.robot)
+        if settings.kind == "evorbc":
+            if repertoire is None:
+                raise ValueError("EvoRBC evolution needs a repertoire")
+            self.controller = evorbc_controller(repertoire, settings.mapping, self.task.robot)
+            n_outputs = 2
+        else:
+            self.controller = standard_controller(self.task.robot)
+            n_outputs = self.task.robot.type.n_parameters
+        self.config = load_neat_config(settings.neat_file, self.task.layout.n_inputs, n_outputs)
+        self.population = neat.Population(self.config, seed=settings.seed)
+        self.history: list[GenerationStats] = []
+        self.best: dict | None = None  # genome_to_dict of the best genome ever
+        self.best_generation = -1
+
+    @property
+    def generation(self) -> int:
+        """Generations evaluated so far."""
+        return self.population.generation
+
+    @property
+    def finished(self) -> bool:
+        """True once every generation has been evaluated."""
+        return self.generation >= self.settings.generations
+
+    def _evaluate(self, genomes, config) -> None:
+        """neat-python fitness function: the batched kernel over all genomes and mazes."""
+        start = time.perf_counter()
+        generation = self.population.generation
+        specs = [network_spec(g, config) for _, g in genomes]
+        rng = np.random.default_rng([self.settings.seed, generation])
+        starts = self.task.sample_starts(rng)
+        result = self.task.run(pack_networks(specs), self.controller, np.arange(len(specs)), starts)
+        fitness = result.fitness.reshape(len(specs), len(starts)).mean(axis=1)
+        reached = result.reached.reshape(len(specs), len(starts)).sum(axis=1)
+        for (_, genome), f in zip(genomes, fitness, strict=True):
+            genome.fitness = float(f)
+        self._eval_seconds = time.perf_counter() - start
+        k = int(np.argmax(fitness))
+        if self.best is None or fitness[k] > self.best["fitness"]:
+            self.best = genome_to_dict(genomes[k][1])
+            self.best_generation = generation
+        self._gen_figures = (float(fitness[k]), float(fitness.mean()), int(reached[k]))
+
+    def step(self) -> GenerationStats:
+        """Evaluate the current generation and breed the next one."""
+        start = time.perf_counter()
+        generation = self.population.generation
+        species = len(self.population.species.species)
+        self.population.run(self._evaluate, 1)
+        best, mean, reached = self._gen_figures
+        stats = GenerationStats(
+            generation=generation,
+            best=best,
+            mean=mean,
+            best_so_far=self.best["fitness"],
+            species=species,
+            seconds=time.perf_counter() - start,
+            evaluation_seconds=self._eval_seconds,
+            best_reached=reached,
+        )
+        self.history.append(stats)
+        return stats
+
+    def result(self, seconds: float) -> EvolutionResult:
+        """The best genome as a network, with the run's history."""
+        from offline_evolution.arbitrator.neat_state import genome_from_dict
+
+        genome = genome_from_dict(self.best, self.config)
+        return EvolutionResult(
+            self.settings,
+            network_spec(genome, self.config),
+            self.best["fitness"],
+            self.best_generation,
+            self.history,
+            seconds,
+        )
+
+    # -- checkpoints -------------------------------------------------------------------
+
+    def save(self, path: str | os.PathLike, elapsed: float) -> None:
+        """Write a JSON checkpoint between generations (atomically)."""
+        data = {
+            "kind": CHECKPOINT_KIND,
+            "settings": self.settings.as_dict(),
+            "population": population_to_dict(self.population),
+            "best": self.best,
+            "best_generation": self.best_generation,
+            "history": [h.as_dict() for h in self.history],
+            "elapsed": elapsed,
+        }
+        atomic_write_text(path, json.dumps(data))
+
+    def restore(self, path: str | os.PathLike) -> float:
+        """Continue from a checkpoint of the same settings; returns its elapsed seconds.
+
+        Raises:
+            CheckpointError: unreadable, not a NEAT checkpoint, or another run's.
+        """
+        try:
+            data = json.loads(Path(path).read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+            raise CheckpointError(f"{path}: not a usable checkpoint ({e})") from None
+        if not isinstance(data, dict) or data.get("kind") != CHECKPOINT_KIND:
+            raise CheckpointError(f"{path}: not a NEAT evolution checkpoint")
+        mismatch = settings_mismatch(data.get("settings", {}), self.settings.as_dict())
+        if mismatch:
+            raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
+        try:
+            self.population = population_from_dict(data["population"], self.config)
+            self.best = data["best"]
+            self.best_generation = int(data["best_generation"])
+            self.history = [GenerationStats(**h) for h in data["history"]]
+            return float(data["elapsed"])
+        except (KeyError, TypeError, ValueError) as e:
+            raise CheckpointError(f"{path}: not a usable checkpoint ({e!r})") from None
+
+
+def evolve(
+    settings: EvolutionSettings,
+    repertoire: Repertoire | None = None,
+    *,
+    checkpoint: str | os.PathLike | None = None,
+    checkpoint_every: int = 10,
+    progress: Callable[[GenerationStats, EvolutionSettings], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> EvolutionResult:
+    """Run NEAT on the maze task to the last generation.
+
+    Args:
+        settings: the run (see :class:`EvolutionSettings`).
+        repertoire: the repertoire an EvoRBC arbitrator chooses from.
+        checkpoint: resumed from if it exists, written every ``checkpoint_every``
+            generations, removed at the end.
+        progress: called after every generation.
+        should_stop: polled after every generation; True saves and raises
+            :class:`~offline_evolution.repertoire.map_elites.Interrupted`.
+    """
+    run = Evolution(settings, repertoire)
+    elapsed = 0.0
+    if checkpoint is not None and os.path.exists(checkpoint):
+        elapsed = run.restore(checkpoint)
+    start = time.perf_counter() - elapsed
+    while not run.finished:
+        stats = run.step()
+        if progress is not None:
+            progress(stats, settings)
+        stop = should_stop is not None and should_stop() and not run.finished
+        due = checkpoint is not None and run.generation % max(1, checkpoint_every) == 0
+        if checkpoint is not None and (due or stop) and not run.finished:
+            run.save(checkpoint, time.perf_counter() - start)
+        if stop:
+            raise Interrupted(run.generation, None if checkpoint is None else str(checkpoint))
+    if checkpoint is not None and os.path.exists(checkpoint):
+        os.remove(checkpoint)
+    return run.result(time.perf_counter() - start)
+
+
+def arbitrator_file(
+    result: EvolutionResult,
+    task: MazeTask,
+    repertoire: Repertoire | None = None,
+    repertoire_source: str | None = None,
+) -> ArbitratorFile:
+    """The arbitrator file of a finished run."""
+    s = result.settings
+    evolution = {
+        "seed": s.seed,
+        "generations": s.generations,
+        "best_fitness": result.best_fitness,
+        "best_generation": result.best_generation,
+        "seconds": round(result.seconds, 1),
+        "neat_settings": Path(s.neat_file).name,
+        "neat_sha256": s.neat_sha256,
+        "task": s.task,
+        "history": [h.as_dict() for h in result.history],
+    }
+    if s.kind == "evorbc":
+        return ArbitratorFile(
+            kind="evorbc",
+            robot=s.robot,
+            network=result.best_network,
+            sensors=task.layout,
+            mapping=s.mapping,
+            control_period=task.dt,
+            evolution=evolution,
+            repertoire={
+                "fingerprint": repertoire.fingerprint(),
+                "robot": repertoire.robot,
+                "count": len(repertoire),
+                "file": Path(repertoire_source).name if repertoire_source else None,
+            },
+        )
+    return ArbitratorFile(
+        kind="standard",
+        robot=s.robot,
+        network=result.best_network,
+        sensors=task.layout,
+        parameters=task.robot.parameter_specs,
+        control_period=task.dt,
+        evolution=evolution,
+    )

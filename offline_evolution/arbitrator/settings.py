@@ -1,0 +1,44 @@
+"""Run-level settings of arbitrator evolution (``config/arbitrator/<family>.yaml``)."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from evorbc_ros.config import build_settings, config_dir, load_yaml_mapping, setting
+from evorbc_ros.mapping import MAPPINGS
+
+
+@dataclass(frozen=True)
+class ArbitratorRunSettings:
+    """Defaults of ``evorbc-evolve arbitrator`` and ``standard`` for a robot family."""
+
+    generations: int = setting(doc="NEAT generations", minimum=1)
+    mapping: str = setting("polar", doc="mapping function", choices=MAPPINGS)
+    neat: str = setting("neat/4ws.ini", doc="NEAT settings file, relative to config/")
+    task: str = setting("tasks/maze-4ws.yaml", doc="task settings file, relative to config/")
+    checkpoint_every: int = setting(10, doc="generations between checkpoints", minimum=1)
+
+    def neat_path(self) -> Path:
+        """The NEAT settings file."""
+        return _resolve(self.neat)
+
+    def task_path(self) -> Path:
+        """The task settings file."""
+        return _resolve(self.task)
+
+
+def _resolve(name: str) -> Path:
+    path = Path(name)
+    return path if path.is_absolute() or path.exists() else config_dir() / name
+
+
+def load_run_settings(
+    path: str | os.PathLike | None = None, robot: str = "4ws-5"
+) -> ArbitratorRunSettings:
+    """Settings from ``path``, by default the shipped file of ``robot``'s family."""
+    if path is None:
+        family = "hexapod" if robot == "hexapod" else "4ws"
+        path = config_dir() / "arbitrator" / f"{family}.yaml"
+    return build_settings(ArbitratorRunSettings, load_yaml_mapping(path), str(path))

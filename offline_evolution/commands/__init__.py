@@ -1,0 +1,1 @@
+"""The subcommands of ``evorbc-evolve``, one module each."""

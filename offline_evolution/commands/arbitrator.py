@@ -1,0 +1,193 @@
+"""``evorbc-evolve arbitrator`` (EvoRBC) and ``standard`` (the standard-NEAT baseline)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from evorbc_ros.repertoire import Repertoire
+from offline_evolution.checkpoint import CheckpointError, Interrupted
+from offline_evolution.commands.common import (
+    EXIT_INTERRUPTED,
+    CliError,
+    StopOnSignal,
+    check_writable,
+    count,
+    default_checkpoint,
+)
+
+
+def _common_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--generations",
+        type=count,
+        metavar="N",
+        help="NEAT generations (default: config/arbitrator/<family>.yaml, Table I)",
+    )
+    p.add_argument("--seed", type=count, default=0, metavar="N", help="random seed (0)")
+    p.add_argument("--out", required=True, metavar="FILE", help="arbitrator file to write (JSON)")
+    p.add_argument(
+        "--config",
+        metavar="FILE.yaml",
+        help="run settings (default: config/arbitrator/<family>.yaml)",
+    )
+    p.add_argument("--neat-config", metavar="FILE.ini", help="NEAT settings (neat-python format)")
+    p.add_argument("--task", metavar="FILE.yaml", help="maze task settings")
+    p.add_argument(
+        "--plot", metavar="FILE.png", help="fitness-curve picture (default: OUT with .fitness.png)"
+    )
+    p.add_argument(
+        "--checkpoint",
+        metavar="FILE",
+        help="resume checkpoint (default: OUT.checkpoint.json); a run resumes "
+        "from it automatically",
+    )
+    p.add_argument(
+        "--checkpoint-every", type=count, metavar="N", help="generations between checkpoints"
+    )
+    p.add_argument(
+        "--restart",
+        action="store_true",
+        help="discard an existing checkpoint and start from scratch",
+    )
+    p.add_argument("--quiet", action="store_true", help="no per-generation lines")
+
+
+def add_parsers(sub) -> None:
+    """Register ``arbitrator`` and ``standard``."""
+    from evorbc_ros.mapping import MAPPINGS
+    from sim_bridge.robots import ROBOT_NAMES
+
+    arb = sub.add_parser(
+        "arbitrator",
+        help="evolve an EvoRBC arbitrator for a repertoire (NEAT)",
+        description="Evolve an arbitrator network with NEAT that maps sensor readings to a "
+        "point of the repertoire's behaviour space (paper Sec. III-C).",
+    )
+    arb.add_argument("--repertoire", required=True, metavar="FILE", help="repertoire file")
+    arb.add_argument("--mapping", choices=MAPPINGS, help="mapping function (default: polar)")
+    _common_options(arb)
+    arb.set_defaults(func=cmd_evolve, kind="evorbc")
+
+    std = sub.add_parser(
+        "standard",
+        help="evolve a standard-NEAT controller (the baseline)",
+        description="Evolve a network whose outputs are the robot's locomotion parameters, "
+        "applied every control cycle (paper Sec. IV-D).",
+    )
+    std.add_argument("--robot", required=True, choices=ROBOT_NAMES, help="robot type")
+    std.add_argument(
+        "--equal-budget",
+        action="store_true",
+        help="add the generations that match EvoRBC's repertoire budget (+25 for the 4WS robots)",
+    )
+    _common_options(std)
+    std.set_defaults(func=cmd_evolve, kind="standard")
+
+
+class _GenerationPrinter:
+    """One line per generation on stderr."""
+
+    def __init__(self, quiet: bool, total: int) -> None:
+        self.quiet = quiet
+        self.total = total
+        self.announced = False
+
+    def __call__(self, stats, settings) -> None:
+        if self.quiet:
+            return
+        remaining = (self.total - stats.generation - 1) * stats.seconds
+        print(
+            f"generation {stats.generation + 1:>4}/{self.total}  best {stats.best:6.3f}  "
+            f"mean {stats.mean:6.3f}  best so far {stats.best_so_far:6.3f}  "
+            f"species {stats.species:>2}  reached {stats.best_reached}  "
+            f"{stats.seconds:5.2f} s/gen  eta {remaining / 60:5.1f} min",
+            file=sys.stderr,
+        )
+
+
+def cmd_evolve(args: argparse.Namespace) -> int:
+    """Evolve an arbitrator or a standard-NEAT controller and write its file and curve."""
+    from offline_evolution.arbitrator.evolve import (
+        EQUAL_BUDGET_GENERATIONS,
+        EvolutionSettings,
+        arbitrator_file,
+        evolve,
+        file_sha256,
+    )
+    from offline_evolution.arbitrator.settings import load_run_settings
+    from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
+
+    repertoire = None
+    if args.kind == "evorbc":
+        repertoire = Repertoire.load(args.repertoire)
+        robot = repertoire.robot
+    else:
+        robot = args.robot
+    run = load_run_settings(args.config, robot)
+    generations = args.generations if args.generations is not None else run.generations
+    if generations < 1:
+        raise CliError("--generations must be at least 1")
+    if args.kind == "standard" and args.equal_budget:
+        generations += EQUAL_BUDGET_GENERATIONS["hexapod" if robot == "hexapod" else "4ws"]
+    neat_file = Path(args.neat_config) if args.neat_config else run.neat_path()
+    task_settings = MazeTaskSettings.load(args.task or run.task_path())
+    if not neat_file.exists():
+        raise CliError(f"{neat_file}: no such NEAT settings file")
+    settings = EvolutionSettings(
+        kind=args.kind,
+        robot=robot,
+        generations=generations,
+        seed=args.seed,
+        neat_file=str(neat_file),
+        neat_sha256=file_sha256(neat_file),
+        task=task_settings.as_dict(),
+        mapping=(args.mapping or run.mapping) if args.kind == "evorbc" else None,
+        repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
+    )
+    out = Path(args.out)
+    plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")
+    checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.json")
+    if args.restart and checkpoint.exists():
+        checkpoint.unlink()
+    check_writable(out, plot)
+    every = args.checkpoint_every or run.checkpoint_every
+    stop = StopOnSignal("generation")
+    previous = stop.install()
+    try:
+        result = evolve(
+            settings,
+            repertoire,
+            checkpoint=checkpoint,
+            checkpoint_every=every,
+            progress=_GenerationPrinter(args.quiet, generations),
+            should_stop=stop,
+        )
+    except CheckpointError as e:
+        raise CliError(f"{e}; use --restart to discard it") from None
+    except Interrupted as e:
+        raise CliError(
+            f"interrupted after generation {e.iteration}; finished work is saved "
+            f"in {e.checkpoint}; run the same command again to resume",
+            EXIT_INTERRUPTED,
+        ) from None
+    finally:
+        stop.restore(previous)
+    task = MazeTask(task_settings, robot)
+    arbitrator_file(result, task, repertoire, args.repertoire if repertoire else None).save(out)
+    from offline_evolution.plots.fitness import plot_fitness_history
+
+    plot_fitness_history(
+        result.history,
+        plot,
+        title=f"{'EvoRBC' if args.kind == 'evorbc' else 'standard NEAT'}, "
+        f"{robot}, seed {args.seed}",
+    )
+    label = "arbitrator" if args.kind == "evorbc" else "standard-NEAT controller"
+    print(
+        f"{robot} {label}: best fitness {result.best_fitness:.3f} (generation "
+        f"{result.best_generation + 1}), {generations} generations in "
+        f"{result.seconds / 60:.1f} min (seed {args.seed}) -> {out}, curve {plot}"
+    )
+    return 0

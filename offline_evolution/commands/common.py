@@ -1,0 +1,97 @@
+"""Helpers shared by the subcommands: errors, argument types, signals, output checks."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import signal
+import sys
+from pathlib import Path
+
+EXIT_ERROR = 1
+EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130
+
+
+class CliError(Exception):
+    """A user-facing error: printed as one line, exit status ``code``."""
+
+    def __init__(self, message: str, code: int = EXIT_ERROR) -> None:
+        super().__init__(message)
+        self.code = code
+
+
+def positive_float(text: str) -> float:
+    """Argparse type: a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    return value
+
+
+def count(text: str) -> int:
+    """Argparse type: an integer >= 0."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a non-negative integer, got {text!r}")
+    return value
+
+
+class StopOnSignal:
+    """First Ctrl-C/SIGTERM: finish the current step, checkpoint, exit. Second: abort."""
+
+    def __init__(self, what: str = "batch") -> None:
+        self.requested = False
+        self.what = what
+
+    def __call__(self) -> bool:
+        """True once a stop was requested."""
+        return self.requested
+
+    def install(self) -> dict:
+        """Install the handlers; return the previous ones for :meth:`restore`."""
+
+        def handler(signum, frame):
+            if self.requested:
+                raise KeyboardInterrupt
+            self.requested = True
+            print(
+                f"\nstopping after this {self.what} (Ctrl-C again to abort without saving)",
+                file=sys.stderr,
+            )
+
+        return {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+
+    @staticmethod
+    def restore(previous: dict) -> None:
+        """Put back the handlers :meth:`install` replaced."""
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+
+def check_writable(*paths) -> None:
+    """Fail early (before a long run) if an output folder cannot be created or written."""
+    for p in paths:
+        if p is None:
+            continue
+        folder = Path(p).resolve().parent
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            raise CliError(f"{p}: cannot create folder {folder} ({e.strerror})") from None
+        if not os.access(folder, os.W_OK):
+            raise CliError(f"{p}: folder {folder} is not writable")
+        if Path(p).is_dir():
+            raise CliError(f"{p}: is a folder, expected a file name")
+
+
+def default_checkpoint(out: Path, given: str | None, suffix: str) -> Path:
+    """The checkpoint path: ``given``, or ``OUT<suffix>`` next to the output."""
+    return Path(given) if given else out.with_name(out.name + suffix)

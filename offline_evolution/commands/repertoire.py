@@ -1,0 +1,185 @@
+"""``evorbc-evolve repertoire`` and ``export-csv``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from evorbc_ros.repertoire import Repertoire
+from offline_evolution.checkpoint import CheckpointError, Interrupted
+from offline_evolution.commands.common import (
+    EXIT_INTERRUPTED,
+    EXIT_USAGE,
+    CliError,
+    StopOnSignal,
+    check_writable,
+    count,
+    default_checkpoint,
+    positive_float,
+)
+
+
+def add_parsers(sub) -> None:
+    """Register ``repertoire`` and ``export-csv``."""
+    from offline_evolution.quality import METRICS
+    from sim_bridge.robots import ROBOT_NAMES
+
+    rep = sub.add_parser(
+        "repertoire",
+        help="generate a MAP-Elites repertoire of locomotion primitives",
+        description="Generate a repertoire with batch MAP-Elites (paper Algorithm 1). "
+        "Settings come from config/repertoire/<family>.yaml (paper Table I) or "
+        "--config; options given here override them.",
+    )
+    rep.add_argument("--robot", choices=ROBOT_NAMES, help="robot type (default: from config)")
+    rep.add_argument("--metric", choices=tuple(METRICS), help="quality metric")
+    rep.add_argument(
+        "--bin-size",
+        type=positive_float,
+        metavar="M",
+        help="side of a square archive cell in metres",
+    )
+    rep.add_argument(
+        "--eval-time",
+        type=positive_float,
+        metavar="S",
+        help="primitive evaluation time T in seconds",
+    )
+    rep.add_argument(
+        "--initial-batch", type=count, metavar="N", help="random solutions in the first batch (S_G)"
+    )
+    rep.add_argument("--batch-size", type=count, metavar="N", help="mutants per iteration (S_B)")
+    rep.add_argument(
+        "--iterations", type=count, metavar="N", help="iterations after the initial batch (I)"
+    )
+    rep.add_argument("--seed", type=count, metavar="N", help="random seed")
+    rep.add_argument("--config", metavar="FILE.yaml", help="settings file (YAML)")
+    rep.add_argument("--out", required=True, metavar="FILE", help="repertoire file to write (JSON)")
+    rep.add_argument("--plot", metavar="FILE.png", help="also draw the repertoire (Fig. 8 style)")
+    rep.add_argument("--csv", metavar="FILE.csv", help="also export the primitives as CSV")
+    rep.add_argument(
+        "--checkpoint",
+        metavar="FILE",
+        help="resume checkpoint (default: OUT.checkpoint.npz); a run resumes from it automatically",
+    )
+    rep.add_argument(
+        "--checkpoint-every",
+        type=count,
+        default=100,
+        metavar="N",
+        help="iterations between checkpoints (default: 100)",
+    )
+    rep.add_argument(
+        "--restart",
+        action="store_true",
+        help="discard an existing checkpoint and start from scratch",
+    )
+    rep.add_argument("--quiet", action="store_true", help="no progress lines")
+    rep.set_defaults(func=cmd_repertoire)
+
+    csv = sub.add_parser("export-csv", help="convert a repertoire file to CSV")
+    csv.add_argument("repertoire", metavar="REPERTOIRE", help="repertoire file (JSON)")
+    csv.add_argument("--out", metavar="FILE.csv", help="CSV file (default: next to the input)")
+    csv.set_defaults(func=cmd_export_csv)
+
+
+class _ProgressPrinter:
+    """Prints a progress line to stderr at most every ``interval`` seconds, and the last."""
+
+    def __init__(self, quiet: bool, interval: float = 1.0) -> None:
+        self.quiet = quiet
+        self.interval = interval
+        self.last = -float("inf")
+        self.announced = False
+
+    def __call__(self, p) -> None:
+        if self.quiet:
+            return
+        if p.resumed_from is not None and not self.announced:
+            print(f"resuming from the checkpoint at iteration {p.resumed_from}", file=sys.stderr)
+        self.announced = True
+        now = time.perf_counter()
+        if now - self.last < self.interval and p.iteration < p.iterations:
+            return
+        self.last = now
+        rate = p.evaluations / p.elapsed if p.elapsed > 0 else 0.0
+        print(
+            f"iteration {p.iteration:>5}/{p.iterations}  evaluations {p.evaluations:>9,}  "
+            f"primitives {p.cells:>5}  mean quality {p.mean_quality:.3f}  "
+            f"QD-score {p.qd_score:8.1f}  {rate / 1e3:7.0f}k eval/s",
+            file=sys.stderr,
+        )
+
+
+def cmd_repertoire(args: argparse.Namespace) -> int:
+    """Generate a repertoire, write it (and optionally a plot and CSV), print a summary."""
+    from offline_evolution.repertoire.map_elites import generate_repertoire
+    from offline_evolution.repertoire.settings import load_settings
+
+    settings = load_settings(
+        args.config,
+        robot=args.robot,
+        metric=args.metric,
+        bin_size=args.bin_size,
+        eval_time=args.eval_time,
+        initial_batch=args.initial_batch,
+        batch_size=args.batch_size,
+        iterations=args.iterations,
+        seed=args.seed,
+    )
+    if settings.initial_batch < 1 or settings.batch_size < 1:
+        raise CliError("--initial-batch and --batch-size must be at least 1", EXIT_USAGE)
+    out = Path(args.out)
+    checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.npz")
+    if args.restart and checkpoint.exists():
+        checkpoint.unlink()
+    check_writable(out, args.plot, args.csv)
+    stop = StopOnSignal("batch")
+    previous_handlers = stop.install()
+    start = time.perf_counter()
+    try:
+        repertoire = generate_repertoire(
+            settings,
+            checkpoint=checkpoint,
+            checkpoint_every=args.checkpoint_every,
+            progress=_ProgressPrinter(args.quiet),
+            should_stop=stop,
+        )
+    except CheckpointError as e:
+        raise CliError(f"{e}; use --restart to discard it") from None
+    except Interrupted as e:
+        raise CliError(
+            f"interrupted after iteration {e.iteration}; finished work is saved in "
+            f"{e.checkpoint}; run the same command again to resume",
+            EXIT_INTERRUPTED,
+        ) from None
+    finally:
+        stop.restore(previous_handlers)
+    elapsed = time.perf_counter() - start
+    repertoire.save(out)
+    if args.plot:
+        from offline_evolution.plots.repertoire import plot_repertoire
+
+        plot_repertoire(repertoire, args.plot)
+    if args.csv:
+        repertoire.to_csv(args.csv)
+    s = repertoire.summary()
+    print(
+        f"{repertoire.robot} repertoire: {s['count']} primitives, mean quality "
+        f"{s['mean_quality']:.3f}, QD-score {s['qd_score']:.1f}, "
+        f"{repertoire.algorithm['evaluations']:,} evaluations in {elapsed:.1f} s "
+        f"(seed {settings.seed}) -> {out}"
+    )
+    return 0
+
+
+def cmd_export_csv(args: argparse.Namespace) -> int:
+    """Convert a repertoire file to CSV."""
+    repertoire = Repertoire.load(args.repertoire)
+    out = Path(args.out) if args.out else Path(args.repertoire).with_suffix(".csv")
+    check_writable(out)
+    repertoire.to_csv(out)
+    print(f"{len(repertoire)} primitives -> {out}")
+    return 0

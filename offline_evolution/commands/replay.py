@@ -1,0 +1,173 @@
+"""``evorbc-evolve replay``: run a controller in the mazes and report per maze."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
+from evorbc_ros.config import build_settings, config_dir
+from evorbc_ros.defaults import default_repertoire
+from evorbc_ros.repertoire import Repertoire
+from offline_evolution.commands.common import CliError, check_writable, count
+
+
+def add_parsers(sub) -> None:
+    """Register ``replay``."""
+    p = sub.add_parser(
+        "replay",
+        help="run a controller in the mazes and report, per maze, reached or not, time and fitness",
+        description="Replay an arbitrator (or a standard-NEAT controller) in the mazes it was "
+        "evolved for.",
+    )
+    p.add_argument("--arbitrator", required=True, metavar="FILE", help="arbitrator file")
+    p.add_argument(
+        "--repertoire",
+        metavar="FILE",
+        help="repertoire of an EvoRBC arbitrator (default: the file it names, next "
+        "to it, or the shipped one)",
+    )
+    p.add_argument(
+        "--maze",
+        default="all",
+        metavar="NAME|all",
+        help="one maze (name or file) or all of the arbitrator's mazes (default)",
+    )
+    p.add_argument(
+        "--task",
+        metavar="FILE.yaml",
+        help="task settings (default: the ones recorded in the arbitrator)",
+    )
+    p.add_argument(
+        "--start",
+        choices=("nominal", "random"),
+        default="nominal",
+        help="each maze's nominal start pose, or a random one from --seed",
+    )
+    p.add_argument("--seed", type=count, default=0, metavar="N", help="seed of random starts")
+    p.add_argument("--plot", metavar="FILE.png", help="draw the trajectories")
+    p.add_argument(
+        "--heatmap",
+        metavar="FILE.png",
+        help="draw which repertoire cells were used (EvoRBC, paper Fig. 14)",
+    )
+    p.add_argument("--json", action="store_true", help="print the results as JSON")
+    p.add_argument(
+        "--allow-mismatch",
+        action="store_true",
+        help="use a repertoire other than the one the arbitrator was evolved with",
+    )
+    p.set_defaults(func=cmd_replay)
+
+
+def resolve_repertoire(
+    arb: ArbitratorFile, arb_path: Path, given: str | None, allow_mismatch: bool
+) -> tuple[Repertoire, str, list[str]]:
+    """The repertoire to replay an EvoRBC arbitrator with, its path and any warnings."""
+    if given:
+        candidates = [Path(given)]
+    else:
+        named = (arb.repertoire or {}).get("file")
+        candidates = [arb_path.with_name(named)] if named else []
+        candidates.append(default_repertoire(arb.robot))
+        candidates = [c for c in candidates if c.exists()]
+        if not candidates:
+            raise CliError(f"{arb_path}: cannot find its repertoire; pass --repertoire FILE")
+    errors = []
+    for path in candidates:
+        repertoire = Repertoire.load(path)
+        try:
+            warnings = arb.check_repertoire(repertoire, str(path), allow_mismatch)
+            return repertoire, str(path), warnings
+        except ArbitratorError as e:
+            errors.append(str(e))
+    raise CliError(
+        errors[0]
+        if given
+        else f"{arb_path}: none of {', '.join(map(str, candidates))} is the repertoire "
+        "it was evolved with; pass --repertoire FILE"
+    )
+
+
+def cmd_replay(args: argparse.Namespace) -> int:
+    """Replay and report; optionally draw trajectories and the selection heatmap."""
+    from offline_evolution.maze_task.replay import replay
+    from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
+
+    arb_path = Path(args.arbitrator)
+    arb = ArbitratorFile.load(arb_path)
+    repertoire, rep_path, warnings = None, None, []
+    if arb.kind == "evorbc":
+        repertoire, rep_path, warnings = resolve_repertoire(
+            arb, arb_path, args.repertoire, args.allow_mismatch
+        )
+    for w in warnings:
+        print(f"evorbc-evolve: warning: {w}", file=sys.stderr)
+    recorded = arb.evolution.get("task")
+    if args.task:
+        settings = MazeTaskSettings.load(args.task)
+    elif recorded:
+        settings = build_settings(MazeTaskSettings, recorded, f"{arb_path}: evolution.task")
+    else:
+        settings = MazeTaskSettings.load(config_dir() / "tasks" / "maze-4ws.yaml")
+    if args.maze != "all":
+        settings = MazeTaskSettings((args.maze,), settings.episode_time, 1, settings.sensors)
+    task = MazeTask(settings, arb.robot)
+    try:
+        arb.check_sensors(task.layout, settings.sensors, args.allow_mismatch)
+    except ArbitratorError as e:
+        raise CliError(str(e)) from None
+    if args.start == "random":
+        starts = task.sample_starts(np.random.default_rng(args.seed))
+    else:
+        starts = task.nominal_starts()
+    check_writable(args.plot, args.heatmap)
+    outcomes, result = replay(arb, task, starts, repertoire)
+    mean = float(np.mean([o.fitness for o in outcomes]))
+    reached = sum(o.reached for o in outcomes)
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "arbitrator": str(arb_path),
+                    "kind": arb.kind,
+                    "robot": arb.robot,
+                    "repertoire": rep_path,
+                    "start": args.start,
+                    "mazes": [o.as_dict() for o in outcomes],
+                    "mean_fitness": mean,
+                    "reached": reached,
+                },
+                indent=1,
+            )
+        )
+    else:
+        print(
+            f"{arb_path}: {arb.kind} controller for {arb.robot}"
+            + (
+                f", {arb.mapping} mapping over {rep_path} ({len(repertoire)} primitives)"
+                if repertoire
+                else ""
+            )
+        )
+        print(f"{'maze':<12} {'reached':>7} {'time (s)':>9} {'fitness':>8}")
+        for o in outcomes:
+            print(
+                f"{o.maze:<12} {'yes' if o.reached else 'no':>7} {o.time:>9.1f} {o.fitness:>8.3f}"
+            )
+        print(f"mean fitness {mean:.3f}, target reached in {reached} of {len(outcomes)} mazes")
+    if args.plot:
+        from offline_evolution.plots.replay import plot_trajectories
+
+        plot_trajectories(task, outcomes, result, args.plot, title=arb_path.name)
+    if args.heatmap:
+        if arb.kind != "evorbc":
+            raise CliError("--heatmap needs an EvoRBC arbitrator (standard NEAT has no primitives)")
+        from offline_evolution.plots.selection import plot_selection
+
+        plot_selection(repertoire, arb.mapping, result, args.heatmap, title=arb_path.name)
+    return 0

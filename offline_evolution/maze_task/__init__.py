@@ -1,0 +1,1 @@
+"""The maze navigation task (paper Sec. IV-B): batched episodes, fitness and replays."""

@@ -1,0 +1,235 @@
+"""The compiled episode kernel: many (controller, maze, start) episodes in one parallel loop.
+
+Each control cycle (0.1 s) of an episode: read the sensors at the robot's pose, evaluate the
+controller's network, turn its outputs into a wheel command, and step the 4WS motion model
+(with wall contact). An EvoRBC controller maps its two outputs to a behaviour-space point and
+runs the nearest primitive (grid lookup); a standard-NEAT controller's outputs are the
+robot's genes. The episode ends when the robot's centre is within the target radius or
+after ``n_cycles`` cycles.
+
+Episodes are independent, so results do not depend on the number of threads.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from evorbc_ros import mapping as onboard_mapping
+from offline_evolution.arbitrator.compiled import activate
+from sim_bridge.four_ws_motion import HEADING, STATE_SIZE, X, Y, step_robot
+from sim_bridge.geometry import grid_candidates
+from sim_bridge.sensors import read_sensors
+
+map_point = nb.njit(cache=True)(onboard_mapping.map_point)
+
+#: Controller modes.
+EVORBC, STANDARD = 0, 1
+
+
+@nb.njit(cache=True)
+def _lookup(x, y, origin, cell, table):
+    """Compiled :meth:`evorbc_ros.mapping.PrimitiveLookup.nearest`."""
+    nx, ny = table.shape
+    i = min(max(math.floor((x - origin[0]) / cell[0]), 0), nx - 1)
+    j = min(max(math.floor((y - origin[1]) / cell[1]), 0), ny - 1)
+    return table[i, j]
+
+
+@nb.njit(cache=True)
+def _candidates(
+    m,
+    x,
+    y,
+    mazes_grid_origin,
+    mazes_grid_shape,
+    grid_cell,
+    cell_base,
+    cell_offsets,
+    cell_ids,
+    all_start,
+    all_ids,
+):
+    base = cell_base[m]
+    nx = mazes_grid_shape[m, 0]
+    ny = mazes_grid_shape[m, 1]
+    return grid_candidates(
+        x,
+        y,
+        mazes_grid_origin[m, 0],
+        mazes_grid_origin[m, 1],
+        grid_cell,
+        nx,
+        ny,
+        cell_offsets[base : base + nx * ny + 1],
+        cell_ids,
+        all_ids[all_start[m] : all_start[m + 1]],
+    )
+
+
+@nb.njit(cache=True, parallel=True)
+def run_episodes(
+    # episodes
+    genome,
+    maze,
+    start,
+    n_cycles,
+    # networks (a NetworkPack)
+    node_start,
+    node_slot,
+    bias,
+    response,
+    activation,
+    aggregation,
+    link_start,
+    link_source,
+    link_weight,
+    max_slots,
+    n_outputs,
+    # mazes (a MazePack)
+    boxes,
+    grid_origin,
+    grid_shape,
+    grid_cell,
+    cell_base,
+    cell_offsets,
+    cell_ids,
+    all_start,
+    all_ids,
+    targets,
+    target_radius,
+    # sensors (a CompiledLayout)
+    ray_angles,
+    max_range,
+    mount_radius,
+    sector_centres,
+    sector_width,
+    goal_bearing,
+    n_inputs,
+    # controller
+    mode,
+    map_kind,
+    map_params,
+    lookup_origin,
+    lookup_cell,
+    lookup_table,
+    primitive_commands,
+    gene_matrix,
+    command_scale,
+    # robot
+    lim,
+    # recording (only if record; else pass 1-sized dummies)
+    record,
+    trace_pose,
+    trace_choice,
+    trace_outputs,
+):
+    """Run every episode ``e`` (genome ``genome[e]`` in maze ``maze[e]`` from ``start[e]``).
+
+    Returns:
+        ``(reached (E,) bool, cycles (E,) int64, final_distance (E,), initial_distance (E,))``;
+        ``cycles`` is the cycle count when the target was reached, else ``n_cycles``.
+    """
+    n_ep = genome.shape[0]
+    reached = np.zeros(n_ep, dtype=np.bool_)
+    cycles = np.full(n_ep, n_cycles, dtype=np.int64)
+    final_distance = np.empty(n_ep)
+    initial_distance = np.empty(n_ep)
+    state = np.zeros((n_ep, STATE_SIZE))
+    for e in nb.prange(n_ep):
+        g = genome[e]
+        m = maze[e]
+        tx = targets[m, 0]
+        ty = targets[m, 1]
+        state[e, X] = start[e, 0]
+        state[e, Y] = start[e, 1]
+        state[e, HEADING] = start[e, 2]
+        inputs = np.empty(n_inputs)
+        values = np.empty(max_slots)
+        out = np.empty(n_outputs)
+        command = np.empty(5)
+        initial_distance[e] = math.hypot(start[e, 0] - tx, start[e, 1] - ty)
+        dist = initial_distance[e]
+        for t in range(n_cycles):
+            x = state[e, X]
+            y = state[e, Y]
+            h = state[e, HEADING]
+            cand = _candidates(
+                m,
+                x,
+                y,
+                grid_origin,
+                grid_shape,
+                grid_cell,
+                cell_base,
+                cell_offsets,
+                cell_ids,
+                all_start,
+                all_ids,
+            )
+            read_sensors(
+                x,
+                y,
+                h,
+                tx,
+                ty,
+                ray_angles,
+                max_range,
+                mount_radius,
+                sector_centres,
+                sector_width,
+                goal_bearing,
+                boxes,
+                cand,
+                inputs,
+            )
+            activate(
+                g,
+                inputs,
+                values,
+                out,
+                node_start,
+                node_slot,
+                bias,
+                response,
+                activation,
+                aggregation,
+                link_start,
+                link_source,
+                link_weight,
+            )
+            choice = -1
+            if mode == EVORBC:
+                px, py = map_point(map_kind, map_params, out[0], out[1])
+                choice = _lookup(px, py, lookup_origin, lookup_cell, lookup_table)
+                for c in range(5):
+                    command[c] = primitive_commands[choice, c]
+            else:
+                for c in range(5):
+                    acc = 0.0
+                    for k in range(n_outputs):
+                        gene = 2.0 * min(max(out[k], 0.0), 1.0) - 1.0
+                        acc += gene * gene_matrix[k, c]
+                    command[c] = acc * command_scale[c]
+            if record:
+                trace_pose[e, t, 0] = x
+                trace_pose[e, t, 1] = y
+                trace_pose[e, t, 2] = h
+                trace_choice[e, t] = choice
+                for k in range(n_outputs):
+                    trace_outputs[e, t, k] = out[k]
+            step_robot(state, e, command, lim, boxes, cand)
+            dist = math.hypot(state[e, X] - tx, state[e, Y] - ty)
+            if dist <= target_radius[m]:
+                reached[e] = True
+                cycles[e] = t + 1
+                break
+        final_distance[e] = dist
+        if record:
+            last = cycles[e]
+            trace_pose[e, last, 0] = state[e, X]
+            trace_pose[e, last, 1] = state[e, Y]
+            trace_pose[e, last, 2] = state[e, HEADING]
+    return reached, cycles, final_distance, initial_distance

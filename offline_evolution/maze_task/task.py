@@ -1,0 +1,256 @@
+"""The maze task: settings, controllers as arrays, episodes and eq. 5 fitness.
+
+A controller's fitness in one episode is (paper eq. 5, DESIGN.md section 4)::
+
+    2 - t / T          if the target was reached after t seconds (T = episode_time)
+    1 - d_f / d_i      otherwise (final over initial distance to the target)
+
+and its fitness for selection is the mean over the task's episodes (one per maze by
+default, new random starts each generation).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from evorbc_ros.config import build_settings, config_dir, load_yaml_mapping, setting
+from evorbc_ros.mapping import MappingFunction, PrimitiveLookup
+from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.sensors import SensorLayout
+from offline_evolution.arbitrator.compiled import NetworkPack
+from offline_evolution.maze_task.kernel import EVORBC, STANDARD, run_episodes
+from offline_evolution.maze_task.world import pack_mazes
+from sim_bridge.maze import load_named_maze
+from sim_bridge.robots.base import control_steps
+from sim_bridge.robots.four_ws import FourWSRobot
+from sim_bridge.sensors import CompiledLayout
+
+#: Episodes handed to a worker thread at a time: small enough to balance episodes that end
+#: early (target reached) against ones that run the full 120 s.
+_CHUNK = 4
+
+
+@dataclass(frozen=True)
+class MazeTaskSettings:
+    """What defines the task (``config/tasks/*.yaml``)."""
+
+    mazes: tuple[str, ...] = setting(doc="maze names or files")
+    episode_time: float = setting(120.0, doc="episode length T (s)", minimum=0.1)
+    samples_per_maze: int = setting(1, doc="random starts per maze per evaluation", minimum=1)
+    sensors: str = setting("sensors/4ws.yaml", doc="sensor layout file, relative to config/")
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> MazeTaskSettings:
+        """Settings from a task file (``config/tasks/*.yaml``)."""
+        return build_settings(cls, load_yaml_mapping(path), str(path))
+
+    def as_dict(self) -> dict:
+        """Plain-data form (recorded in arbitrator files)."""
+        return {
+            "mazes": list(self.mazes),
+            "episode_time": self.episode_time,
+            "samples_per_maze": self.samples_per_maze,
+            "sensors": self.sensors,
+        }
+
+
+class ControllerArrays(NamedTuple):
+    """How network outputs become wheel commands, as arrays for the kernel."""
+
+    mode: int
+    map_kind: int
+    map_params: tuple[float, float, float, float]
+    lookup_origin: np.ndarray  # (2,)
+    lookup_cell: np.ndarray  # (2,)
+    lookup_table: np.ndarray  # (nx, ny) int64
+    primitive_commands: np.ndarray  # (n_primitives, 5)
+    gene_matrix: np.ndarray  # (n_genes, 5)
+    command_scale: np.ndarray  # (5,)
+
+
+def evorbc_controller(
+    repertoire: Repertoire, mapping: str, robot: FourWSRobot, grid_cells: int = 256
+) -> ControllerArrays:
+    """Arrays of an EvoRBC controller: mapping, lookup grid and each primitive's command."""
+    fn = MappingFunction.for_behaviours(mapping, repertoire.behaviour)
+    lookup = PrimitiveLookup.build(repertoire.behaviour, fn.domain(), grid_cells)
+    commands = robot.type.commands(repertoire.genes, robot.geometry)
+    return ControllerArrays(
+        EVORBC,
+        fn.kind,
+        fn.params,
+        np.array(lookup.origin),
+        np.array(lookup.cell),
+        lookup.table,
+        np.ascontiguousarray(commands),
+        np.zeros((1, 5)),
+        np.zeros(5),
+    )
+
+
+def standard_controller(robot: FourWSRobot) -> ControllerArrays:
+    """Arrays of a standard-NEAT controller: outputs are the robot's genes."""
+    g = robot.geometry
+    scale = np.array([g.max_speed] + [g.max_wheel_angle] * 4)
+    return ControllerArrays(
+        STANDARD,
+        0,
+        (0.0, 0.0, 0.0, 0.0),
+        np.zeros(2),
+        np.ones(2),
+        np.zeros((1, 1), dtype=np.int64),
+        np.zeros((1, 5)),
+        np.ascontiguousarray(robot.type.gene_matrix),
+        scale,
+    )
+
+
+class EpisodeResult(NamedTuple):
+    """Per-episode outcome (arrays of length E) and, if recorded, traces."""
+
+    reached: np.ndarray  # bool
+    cycles: np.ndarray  # int, control cycles run (to the target, or all)
+    final_distance: np.ndarray  # m
+    initial_distance: np.ndarray  # m
+    fitness: np.ndarray  # eq. 5
+    pose: np.ndarray | None = None  # (E, n_cycles + 1, 3) x, y, heading per cycle
+    choice: np.ndarray | None = None  # (E, n_cycles) primitive index (-1: standard)
+    outputs: np.ndarray | None = None  # (E, n_cycles, n_outputs) network outputs
+
+
+class MazeTask:
+    """The maze task for one 4WS robot: mazes, sensors and the compiled kernel."""
+
+    def __init__(self, settings: MazeTaskSettings, robot: str):
+        self.settings = settings
+        self.robot = FourWSRobot(robot)
+        self.mazes = [load_named_maze(name) for name in settings.mazes]
+        self.layout = SensorLayout.load(config_dir() / settings.sensors)
+        self.sensors = CompiledLayout(self.layout)
+        self.dt = self.robot.control_period
+        self.n_cycles = control_steps(settings.episode_time, self.dt)
+        # Walls a ray or the footprint can touch from a cell: sensor reach plus a step and
+        # a margin (m).
+        self.pack = pack_mazes(self.mazes, reach=self.sensors.reach() + 0.1)
+
+    @property
+    def n_mazes(self) -> int:
+        """Number of mazes."""
+        return len(self.mazes)
+
+    def sample_starts(self, rng: np.random.Generator) -> np.ndarray:
+        """``(n_mazes * samples_per_maze, 4)`` rows ``(maze, x, y, heading)``."""
+        rows = []
+        for k, maze in enumerate(self.mazes):
+            poses = maze.sample_starts(
+                rng, self.settings.samples_per_maze, self.robot.geometry.footprint_radius
+            )
+            rows += [(k, *p) for p in poses]
+        return np.array(rows, dtype=np.float64)
+
+    def nominal_starts(self) -> np.ndarray:
+        """One row ``(maze, x, y, heading)`` per maze at its nominal start pose."""
+        return np.array([(k, *m.start_pose) for k, m in enumerate(self.mazes)])
+
+    def run(
+        self,
+        networks: NetworkPack,
+        controller: ControllerArrays,
+        genomes: np.ndarray,
+        starts: np.ndarray,
+        record: bool = False,
+    ) -> EpisodeResult:
+        """Run every genome index in ``genomes`` from every start row in ``starts``.
+
+        Episodes are ordered genome-major: episode ``i * len(starts) + j`` is genome
+        ``genomes[i]`` from start ``j``.
+        """
+        genomes = np.asarray(genomes, dtype=np.int64)
+        n_starts = len(starts)
+        genome = np.repeat(genomes, n_starts)
+        maze = np.tile(starts[:, 0].astype(np.int64), len(genomes))
+        start = np.ascontiguousarray(np.tile(starts[:, 1:4], (len(genomes), 1)))
+        n_ep = len(genome)
+        if record:
+            pose = np.full((n_ep, self.n_cycles + 1, 3), np.nan)
+            choice = np.full((n_ep, self.n_cycles), -2, dtype=np.int64)
+            outputs = np.full((n_ep, self.n_cycles, networks.n_outputs), np.nan)
+        else:
+            pose = np.zeros((1, 1, 3))
+            choice = np.zeros((1, 1), dtype=np.int64)
+            outputs = np.zeros((1, 1, 1))
+        n, p, s, c = networks, self.pack, self.sensors, controller
+        with numba.parallel_chunksize(_CHUNK):
+            reached, cycles, final, initial = run_episodes(
+                genome,
+                maze,
+                start,
+                self.n_cycles,
+                n.node_start,
+                n.node_slot,
+                n.bias,
+                n.response,
+                n.activation,
+                n.aggregation,
+                n.link_start,
+                n.link_source,
+                n.link_weight,
+                int(n.n_slots.max()),
+                n.n_outputs,
+                p.boxes,
+                p.grid_origin,
+                p.grid_shape,
+                p.grid_cell,
+                p.cell_base,
+                p.cell_offsets,
+                p.cell_ids,
+                p.all_start,
+                p.all_ids,
+                p.targets,
+                p.target_radius,
+                s.ray_angles,
+                s.max_range,
+                s.mount_radius,
+                s.sector_centres,
+                s.sector_width,
+                s.goal_bearing,
+                s.n_inputs,
+                c.mode,
+                c.map_kind,
+                c.map_params,
+                c.lookup_origin,
+                c.lookup_cell,
+                c.lookup_table,
+                c.primitive_commands,
+                c.gene_matrix,
+                c.command_scale,
+                self.robot.limits,
+                record,
+                pose,
+                choice,
+                outputs,
+            )
+        fitness = self.fitness(reached, cycles, final, initial)
+        if not record:
+            return EpisodeResult(reached, cycles, final, initial, fitness)
+        return EpisodeResult(reached, cycles, final, initial, fitness, pose, choice, outputs)
+
+    def fitness(self, reached, cycles, final, initial) -> np.ndarray:
+        """Eq. 5 for each episode."""
+        t = cycles * self.dt
+        with np.errstate(divide="ignore", invalid="ignore"):
+            missed = np.where(initial > 0, 1.0 - final / initial, 0.0)
+        return np.where(reached, 2.0 - t / self.settings.episode_time, missed)
+
+    def mean_fitness(
+        self, networks: NetworkPack, controller: ControllerArrays, starts: np.ndarray
+    ) -> np.ndarray:
+        """Each network's fitness: the mean of eq. 5 over the episodes from ``starts``."""
+        n = len(networks.n_slots)
+        result = self.run(networks, controller, np.arange(n), starts)
+        return result.fitness.reshape(n, len(starts)).mean(axis=1)

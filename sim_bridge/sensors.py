@@ -1,0 +1,91 @@
+"""Simulated sensors of a robot in a maze, compiled (DESIGN.md section 5).
+
+The reading formulas are the onboard ones from :mod:`evorbc_ros.sensors`, compiled as they
+are, so the simulator and the ROS sensor nodes cannot drift apart. Rays are cast against
+the maze's wall boxes (see :mod:`sim_bridge.geometry`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from evorbc_ros import sensors as onboard
+from evorbc_ros.sensors import SensorLayout
+from sim_bridge.geometry import cast_ray
+
+range_reading = nb.njit(cache=True)(onboard.range_reading)
+in_sector = nb.njit(cache=True)(onboard.in_sector)
+goal_bearing_reading = nb.njit(cache=True)(onboard.goal_bearing_reading)
+
+
+class CompiledLayout:
+    """A :class:`SensorLayout` as arrays for the compiled kernels.
+
+    Attributes:
+        ray_angles: ``(n_rangefinders, rays)`` ray directions in the body frame, rad.
+        max_range, mount_radius: m.
+        sector_centres: ``(n_sectors,)`` rad; ``sector_width`` rad.
+        goal_bearing: 1 if the layout ends with a goal-bearing input, else 0.
+    """
+
+    def __init__(self, layout: SensorLayout) -> None:
+        rf = layout.rangefinders
+        self.ray_angles = (rf.ray_angles() if rf else np.zeros((0, 1))).astype(np.float64)
+        self.max_range = float(rf.max_range) if rf else 1.0
+        self.mount_radius = float(rf.mount_radius) if rf else 0.0
+        gs = layout.goal_sectors
+        self.sector_centres = np.array(gs.centres if gs else (), dtype=np.float64)
+        self.sector_width = float(gs.width) if gs else 0.0
+        self.goal_bearing = int(layout.goal_bearing)
+        self.n_inputs = layout.n_inputs
+
+    def reach(self) -> float:
+        """How far from the body centre a ray can see (m)."""
+        return self.mount_radius + self.max_range
+
+
+@nb.njit(cache=True)
+def read_sensors(
+    x,
+    y,
+    heading,
+    tx,
+    ty,
+    ray_angles,
+    max_range,
+    mount_radius,
+    sector_centres,
+    sector_width,
+    goal_bearing,
+    boxes,
+    candidates,
+    out,
+):
+    """Write the arbitrator inputs of a robot at pose ``(x, y, heading)`` into ``out``.
+
+    ``(tx, ty)`` is the goal (m, world). Rangefinder rays start at the mount point on the
+    body's edge; goal sectors and bearing come from the goal's bearing in the body frame.
+    """
+    n = 0
+    for s in range(ray_angles.shape[0]):
+        nearest = max_range
+        for r in range(ray_angles.shape[1]):
+            a = heading + ray_angles[s, r]
+            c = math.cos(a)
+            sn = math.sin(a)
+            d = cast_ray(
+                x + mount_radius * c, y + mount_radius * sn, a, max_range, boxes, candidates
+            )
+            nearest = min(nearest, d)
+        out[n] = range_reading(nearest, max_range)
+        n += 1
+    if sector_centres.shape[0] > 0 or goal_bearing:
+        bearing = math.atan2(ty - y, tx - x) - heading
+        for k in range(sector_centres.shape[0]):
+            out[n] = 1.0 if in_sector(bearing, sector_centres[k], sector_width) else 0.0
+            n += 1
+        if goal_bearing:
+            out[n] = goal_bearing_reading(bearing)
