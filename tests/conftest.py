@@ -23,3 +23,35 @@ def small_settings(**overrides):
 def small_repertoire():
     """A small 4ws-5 repertoire, generated once per test session."""
     return generate_repertoire(small_settings())
+
+
+SMALL_TASK = {
+    "mazes": ["obstacle", "gaps"],
+    "episode_time": 15.0,
+    "samples_per_maze": 1,
+    "sensors": "sensors/4ws.yaml",
+}
+
+
+@pytest.fixture
+def small_neat_file(tmp_path):
+    """The shipped NEAT settings with a population of 24 (fast tests)."""
+    text = (
+        open("config/neat/4ws.ini")
+        .read()
+        .replace("pop_size              = 150", "pop_size              = 24")
+    )
+    assert "pop_size              = 24" in text
+    path = tmp_path / "small.ini"
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture
+def small_task_file(tmp_path):
+    """A two-maze, 15 s task file."""
+    import yaml
+
+    path = tmp_path / "task.yaml"
+    path.write_text(yaml.safe_dump(SMALL_TASK))
+    return path

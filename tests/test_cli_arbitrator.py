@@ -1,0 +1,142 @@
+"""``evorbc-evolve arbitrator``, ``standard`` and ``replay`` end to end (small budgets)."""
+
+import json
+
+import pytest
+
+from evorbc_ros.arbitrator import ArbitratorFile
+from offline_evolution.cli import main
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def evolved(tmp_path, capsys, small_repertoire, small_neat_file, small_task_file):
+    rep = tmp_path / "r.json"
+    small_repertoire.save(rep)
+    out = tmp_path / "a.json"
+    code, stdout, stderr = run(
+        capsys,
+        "arbitrator",
+        "--repertoire",
+        rep,
+        "--generations",
+        3,
+        "--seed",
+        2,
+        "--neat-config",
+        small_neat_file,
+        "--task",
+        small_task_file,
+        "--out",
+        out,
+    )
+    assert code == 0, stderr
+    return out, rep, stdout, stderr
+
+
+def test_arbitrator_writes_file_curve_and_summary(evolved, tmp_path):
+    out, _, stdout, stderr = evolved
+    assert stdout.startswith("4ws-5 arbitrator: best fitness") and len(stdout.splitlines()) == 1
+    assert stderr.count("generation ") == 3 and "species" in stderr and "s/gen" in stderr
+    assert (tmp_path / "a.fitness.png").read_bytes()[:4] == b"\x89PNG"
+    arb = ArbitratorFile.load(out)
+    assert arb.evolution["generations"] == 3 and len(arb.evolution["history"]) == 3
+    assert not (tmp_path / "a.json.checkpoint.json").exists()
+
+
+def test_replay_reports_each_maze(evolved, tmp_path, capsys):
+    out, _, _, _ = evolved
+    code, stdout, err = run(
+        capsys,
+        "replay",
+        "--arbitrator",
+        out,
+        "--json",
+        "--plot",
+        tmp_path / "t.png",
+        "--heatmap",
+        tmp_path / "h.png",
+    )
+    assert code == 0, err
+    report = json.loads(stdout)
+    assert [m["maze"] for m in report["mazes"]] == ["obstacle", "gaps"]
+    assert {"reached", "time", "fitness"} <= set(report["mazes"][0])
+    assert (tmp_path / "t.png").exists() and (tmp_path / "h.png").exists()
+    code, stdout, _ = run(capsys, "replay", "--arbitrator", out, "--maze", "gaps")
+    assert code == 0 and "gaps" in stdout and "obstacle" not in stdout
+    assert "target reached in" in stdout
+
+
+def test_replay_refuses_another_repertoire(evolved, tmp_path, capsys, small_repertoire):
+    out, _, _, _ = evolved
+    data = small_repertoire.to_dict()
+    data["primitives"] = {k: v[:-1] for k, v in data["primitives"].items()}
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps(data))
+    code, _, err = run(capsys, "replay", "--arbitrator", out, "--repertoire", other)
+    assert code == 1 and "does not match the arbitrator" in err and len(err.splitlines()) == 1
+    code, _, err = run(
+        capsys, "replay", "--arbitrator", out, "--repertoire", other, "--allow-mismatch"
+    )
+    assert code == 0 and "warning" in err
+
+
+def test_standard_with_equal_budget_adds_25_generations(
+    tmp_path, capsys, small_neat_file, small_task_file
+):
+    out = tmp_path / "s.json"
+    code, stdout, err = run(
+        capsys,
+        "standard",
+        "--robot",
+        "2ws-2",
+        "--generations",
+        1,
+        "--equal-budget",
+        "--neat-config",
+        small_neat_file,
+        "--task",
+        small_task_file,
+        "--quiet",
+        "--out",
+        out,
+    )
+    assert code == 0, err
+    arb = ArbitratorFile.load(out)
+    assert arb.kind == "standard" and arb.evolution["generations"] == 26
+    assert [p.name for p in arb.parameters] == ["speed", "angle_front"]
+    assert "standard-NEAT controller" in stdout
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (
+            ["arbitrator", "--repertoire", "missing.json", "--out", "a.json"],
+            "missing.json: no such repertoire file",
+        ),
+        (["replay", "--arbitrator", "missing.json"], "missing.json: no such arbitrator file"),
+        (
+            ["standard", "--robot", "4ws-5", "--neat-config", "nope.ini", "--out", "a.json"],
+            "nope.ini: no such NEAT settings file",
+        ),
+    ],
+)
+def test_bad_files_exit_with_one_line(tmp_path, capsys, monkeypatch, argv, needle):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run(capsys, *argv)
+    assert code == 1 and needle in err and len(err.strip().splitlines()) == 1
+
+
+def test_bad_neat_settings_are_named(tmp_path, capsys, small_neat_file):
+    bad = tmp_path / "bad.ini"
+    bad.write_text(small_neat_file.read_text().replace("pop_size", "population"))
+    code, _, err = run(
+        capsys, "standard", "--robot", "4ws-5", "--neat-config", bad, "--out", tmp_path / "s.json"
+    )
+    assert code == 1 and str(bad) in err and "pop_size" in err

@@ -1,0 +1,115 @@
+"""Arbitrator evolution: determinism, JSON checkpoints and exact resume."""
+
+import json
+
+import numpy as np
+import pytest
+from conftest import SMALL_TASK
+
+from evorbc_ros.arbitrator import Arbitrator, ArbitratorFile
+from offline_evolution.arbitrator.evolve import (
+    EvolutionSettings,
+    arbitrator_file,
+    evolve,
+    file_sha256,
+)
+from offline_evolution.checkpoint import CheckpointError, Interrupted
+from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
+
+
+def settings(neat_file, kind="evorbc", seed=3, generations=6, repertoire=None):
+    return EvolutionSettings(
+        kind=kind,
+        robot="4ws-5",
+        generations=generations,
+        seed=seed,
+        neat_file=str(neat_file),
+        neat_sha256=file_sha256(neat_file),
+        task=SMALL_TASK,
+        mapping="polar" if kind == "evorbc" else None,
+        repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
+    )
+
+
+def same(a, b):
+    assert a.best_network == b.best_network
+    assert a.best_fitness == b.best_fitness and a.best_generation == b.best_generation
+    strip = [("seconds", "evaluation_seconds")]
+    for x, y in zip(a.history, b.history, strict=True):
+        dx, dy = x.as_dict(), y.as_dict()
+        for key in strip[0]:
+            dx.pop(key), dy.pop(key)
+        assert dx == dy
+
+
+def test_same_seed_same_run_other_seed_differs(small_neat_file, small_repertoire):
+    s = settings(small_neat_file, repertoire=small_repertoire)
+    a = evolve(s, small_repertoire)
+    same(a, evolve(s, small_repertoire))
+    other = evolve(settings(small_neat_file, seed=4, repertoire=small_repertoire), small_repertoire)
+    assert other.best_network != a.best_network
+    assert len(a.history) == 6 and a.history[-1].best_so_far == a.best_fitness
+
+
+def test_interrupted_run_resumes_to_the_same_result(tmp_path, small_neat_file, small_repertoire):
+    s = settings(small_neat_file, generations=8, repertoire=small_repertoire)
+    straight = evolve(s, small_repertoire)
+    ckpt = tmp_path / "run.checkpoint.json"
+    polls = []
+    with pytest.raises(Interrupted) as info:
+        evolve(
+            s,
+            small_repertoire,
+            checkpoint=ckpt,
+            checkpoint_every=100,
+            should_stop=lambda: polls.append(1) or len(polls) == 3,
+        )
+    assert info.value.iteration == 3
+    data = json.loads(ckpt.read_text())  # plain JSON: nothing to unpickle
+    assert data["population"]["generation"] == 3 and len(data["history"]) == 3
+    resumed = evolve(s, small_repertoire, checkpoint=ckpt)
+    same(straight, resumed)
+    assert not ckpt.exists()
+
+
+def test_checkpoint_of_another_run_is_refused(tmp_path, small_neat_file, small_repertoire):
+    ckpt = tmp_path / "c.json"
+    s = settings(small_neat_file, repertoire=small_repertoire)
+    with pytest.raises(Interrupted):
+        evolve(s, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    with pytest.raises(CheckpointError, match="seed is 3 in the checkpoint but 5 now"):
+        evolve(
+            settings(small_neat_file, seed=5, repertoire=small_repertoire),
+            small_repertoire,
+            checkpoint=ckpt,
+        )
+    ckpt.write_text(ckpt.read_text()[:500])
+    with pytest.raises(CheckpointError, match="not a usable checkpoint"):
+        evolve(s, small_repertoire, checkpoint=ckpt)
+
+
+def test_standard_neat_drives_the_parameters(small_neat_file):
+    result = evolve(settings(small_neat_file, kind="standard", generations=3), None)
+    assert len(result.best_network.output_keys) == 5  # speed and four wheel angles
+
+
+def test_arbitrator_file_of_a_run_reproduces_its_fitness(
+    tmp_path, small_neat_file, small_repertoire
+):
+    s = settings(small_neat_file, repertoire=small_repertoire)
+    result = evolve(s, small_repertoire)
+    task = MazeTask(
+        MazeTaskSettings(**{**SMALL_TASK, "mazes": tuple(SMALL_TASK["mazes"])}), "4ws-5"
+    )
+    path = tmp_path / "a.json"
+    arbitrator_file(result, task, small_repertoire, "r.json").save(path)
+    loaded = ArbitratorFile.load(path)
+    assert loaded.repertoire["fingerprint"] == small_repertoire.fingerprint()
+    assert loaded.evolution["best_fitness"] == result.best_fitness
+    # The best genome's fitness came from the starts of its generation.
+    rng = np.random.default_rng([s.seed, result.best_generation])
+    from offline_evolution.maze_task.replay import replay
+
+    outcomes, _ = replay(loaded, task, task.sample_starts(rng), small_repertoire)
+    assert np.mean([o.fitness for o in outcomes]) == pytest.approx(result.best_fitness, abs=1e-12)
+    Arbitrator(loaded, small_repertoire).choose(np.zeros(10))
