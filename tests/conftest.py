@@ -36,11 +36,10 @@ SMALL_TASK = {
 @pytest.fixture
 def small_neat_file(tmp_path):
     """The shipped NEAT settings with a population of 24 (fast tests)."""
-    text = (
-        open("config/neat/4ws.ini")
-        .read()
-        .replace("pop_size              = 150", "pop_size              = 24")
-    )
+    from evorbc_ros.config import config_dir
+
+    shipped = (config_dir() / "neat" / "4ws.ini").read_text()
+    text = shipped.replace("pop_size              = 150", "pop_size              = 24")
     assert "pop_size              = 24" in text
     path = tmp_path / "small.ini"
     path.write_text(text)
