@@ -55,6 +55,22 @@ class GoalSectorLayout:
     centres: tuple[float, ...]
     width: float
 
+    @property
+    def tiles(self) -> bool:
+        """True if the sectors cover the circle edge to edge in order (like the 4WS radar).
+
+        Then each bearing lights exactly one sector, found from one wrapped angle, so no
+        rounding at a shared edge can light none or two.
+        """
+        n = len(self.centres)
+        if abs(n * self.width - 2.0 * math.pi) > 1e-9:
+            return False
+        c0 = self.centres[0]
+        return all(
+            abs(math.remainder(c - c0 - k * self.width, 2.0 * math.pi)) < 1e-9
+            for k, c in enumerate(self.centres)
+        )
+
 
 @dataclass(frozen=True)
 class SensorLayout:
@@ -90,16 +106,16 @@ class SensorLayout:
         if self.rangefinders:
             r = self.rangefinders
             out["rangefinders"] = {
-                "angles_deg": [math.degrees(a) for a in r.angles],
+                "angles_deg": [_degrees(a) for a in r.angles],
                 "range": r.max_range,
                 "mount_radius": r.mount_radius,
-                "field_of_view_deg": math.degrees(r.field_of_view),
+                "field_of_view_deg": _degrees(r.field_of_view),
                 "rays": r.rays,
             }
         if self.goal_sectors:
             out["goal_sectors"] = {
-                "centres_deg": [math.degrees(c) for c in self.goal_sectors.centres],
-                "width_deg": math.degrees(self.goal_sectors.width),
+                "centres_deg": [_degrees(c) for c in self.goal_sectors.centres],
+                "width_deg": _degrees(self.goal_sectors.width),
             }
         if self.goal_bearing:
             out["goal_bearing"] = True
@@ -150,6 +166,11 @@ class SensorLayout:
                 ),
                 rays=rays,
             )
+            if rf.field_of_view == 0.0 and rays > 1:
+                raise ConfigError(
+                    f"{source}: rangefinders.rays is {rays} but field_of_view_deg is 0; "
+                    "several rays need a field of view to spread over"
+                )
         if "goal_sectors" in data:
             d = _mapping(data["goal_sectors"], "goal_sectors", source, {"centres_deg", "width_deg"})
             centres = _number_list(d.get("centres_deg"), "goal_sectors.centres_deg", source)
@@ -169,6 +190,14 @@ class SensorLayout:
     def load(cls, path: str | os.PathLike) -> SensorLayout:
         """Load a layout from a YAML file."""
         return cls.from_dict(load_yaml_mapping(path), str(path))
+
+
+def _degrees(angle: float) -> float:
+    """Degrees for files, rounded to 1e-9 deg so that files read back exactly.
+
+    Without the rounding the shipped 60 deg would be written as 59.99999999999999.
+    """
+    return round(math.degrees(angle), 9) + 0.0  # + 0.0 turns -0.0 into 0.0
 
 
 def _mapping(value, where: str, source: str, keys: set[str]) -> dict:
@@ -217,10 +246,20 @@ def range_reading(distance: float, max_range: float) -> float:
 def in_sector(bearing: float, centre: float, width: float) -> bool:
     """True if ``bearing`` lies in ``[centre - width/2, centre + width/2)`` (rad, wrapped).
 
-    Scalar and plain ``math`` so that the compiled simulator uses the same formula.
+    Used for layouts whose sectors do not tile the circle. Scalar and plain ``math`` so
+    that the compiled simulator uses the same formula.
     """
     rel = (bearing - centre + math.pi) % (2.0 * math.pi) - math.pi
     return -0.5 * width <= rel < 0.5 * width
+
+
+def tiling_sector(bearing: float, first_centre: float, width: float, n: int) -> int:
+    """Index of the sector holding ``bearing`` when ``n`` sectors tile the circle.
+
+    Sector ``k`` covers ``[first_centre + (k - 1/2) width, first_centre + (k + 1/2) width)``.
+    """
+    u = (bearing - first_centre + 0.5 * width) % (2.0 * math.pi)
+    return min(int(u // width), n - 1)  # u can round up to 2 pi: that is sector 0's start
 
 
 def goal_bearing_reading(bearing: float) -> float:
@@ -241,4 +280,8 @@ def rangefinder_readings(distances: np.ndarray, layout: RangefinderLayout) -> np
 
 def goal_sector_readings(bearing: float, layout: GoalSectorLayout) -> np.ndarray:
     """1 for each sector that contains ``bearing`` (rad, body frame), else 0."""
+    if layout.tiles:
+        out = np.zeros(len(layout.centres))
+        out[tiling_sector(bearing, layout.centres[0], layout.width, len(layout.centres))] = 1.0
+        return out
     return np.array([float(in_sector(bearing, c, layout.width)) for c in layout.centres])

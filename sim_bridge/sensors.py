@@ -18,6 +18,7 @@ from sim_bridge.geometry import cast_ray
 
 range_reading = nb.njit(cache=True)(onboard.range_reading)
 in_sector = nb.njit(cache=True)(onboard.in_sector)
+tiling_sector = nb.njit(cache=True)(onboard.tiling_sector)
 goal_bearing_reading = nb.njit(cache=True)(onboard.goal_bearing_reading)
 
 
@@ -27,7 +28,8 @@ class CompiledLayout:
     Attributes:
         ray_angles: ``(n_rangefinders, rays)`` ray directions in the body frame, rad.
         max_range, mount_radius: m.
-        sector_centres: ``(n_sectors,)`` rad; ``sector_width`` rad.
+        sector_centres: ``(n_sectors,)`` rad; ``sector_width`` rad; ``sector_tiles`` 1 if
+            the sectors tile the circle (one index per bearing), else 0.
         goal_bearing: 1 if the layout ends with a goal-bearing input, else 0.
     """
 
@@ -39,6 +41,7 @@ class CompiledLayout:
         gs = layout.goal_sectors
         self.sector_centres = np.array(gs.centres if gs else (), dtype=np.float64)
         self.sector_width = float(gs.width) if gs else 0.0
+        self.sector_tiles = int(bool(gs and gs.tiles))
         self.goal_bearing = int(layout.goal_bearing)
         self.n_inputs = layout.n_inputs
 
@@ -59,6 +62,7 @@ def read_sensors(
     mount_radius,
     sector_centres,
     sector_width,
+    sector_tiles,
     goal_bearing,
     boxes,
     candidates,
@@ -84,8 +88,14 @@ def read_sensors(
         n += 1
     if sector_centres.shape[0] > 0 or goal_bearing:
         bearing = math.atan2(ty - y, tx - x) - heading
-        for k in range(sector_centres.shape[0]):
-            out[n] = 1.0 if in_sector(bearing, sector_centres[k], sector_width) else 0.0
-            n += 1
+        n_sectors = sector_centres.shape[0]
+        if sector_tiles:
+            lit = tiling_sector(bearing, sector_centres[0], sector_width, n_sectors)
+            for k in range(n_sectors):
+                out[n + k] = 1.0 if k == lit else 0.0
+        else:
+            for k in range(n_sectors):
+                out[n + k] = 1.0 if in_sector(bearing, sector_centres[k], sector_width) else 0.0
+        n += n_sectors
         if goal_bearing:
             out[n] = goal_bearing_reading(bearing)

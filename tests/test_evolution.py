@@ -93,7 +93,7 @@ def test_standard_neat_drives_the_parameters(small_neat_file):
     assert len(result.best_network.output_keys) == 5  # speed and four wheel angles
 
 
-def test_arbitrator_file_of_a_run_reproduces_its_fitness(
+def test_arbitrator_file_holds_the_post_evaluated_controller(
     tmp_path, small_neat_file, small_repertoire
 ):
     s = settings(small_neat_file, repertoire=small_repertoire)
@@ -106,10 +106,33 @@ def test_arbitrator_file_of_a_run_reproduces_its_fitness(
     loaded = ArbitratorFile.load(path)
     assert loaded.repertoire["fingerprint"] == small_repertoire.fingerprint()
     assert loaded.evolution["best_fitness"] == result.best_fitness
-    # The best genome's fitness came from the starts of its generation.
-    rng = np.random.default_rng([s.seed, result.best_generation])
+    assert loaded.network == result.selected_network
+    from offline_evolution.arbitrator.selection import post_evaluation_starts
     from offline_evolution.maze_task.replay import replay
 
-    outcomes, _ = replay(loaded, task, task.sample_starts(rng), small_repertoire)
+    # The file's controller scores its recorded post-evaluation fitness on those starts ...
+    starts = post_evaluation_starts(task, s.seed, s.post_samples)
+    assert len(starts) == 2 * (1 + s.post_samples)
+    outcomes, _ = replay(loaded, task, starts, small_repertoire)
+    post = loaded.evolution["post_evaluation"]
+    assert np.mean([o.fitness for o in outcomes]) == pytest.approx(post["fitness"], abs=1e-12)
+    assert post["fitness"] == result.post_evaluation.all_fitness.max()
+    # ... and the best training genome reproduces its fitness on its generation's starts.
+    best = ArbitratorFile(**{**vars(loaded), "network": result.best_network})
+    rng = np.random.default_rng([s.seed, result.best_generation])
+    outcomes, _ = replay(best, task, task.sample_starts(rng), small_repertoire)
     assert np.mean([o.fitness for o in outcomes]) == pytest.approx(result.best_fitness, abs=1e-12)
     Arbitrator(loaded, small_repertoire).choose(np.zeros(10))
+
+
+def test_hall_of_fame_keeps_the_top_and_the_recent_champions():
+    from offline_evolution.arbitrator.selection import HallOfFame
+
+    hall = HallOfFame(3)
+    hall.update([{"key": k, "fitness": f} for k, f in [(1, 0.5), (2, 0.9), (3, 0.1)]])
+    hall.update([{"key": k, "fitness": f} for k, f in [(4, 0.2), (5, 0.3), (2, 0.9)]])
+    hall.update([{"key": 6, "fitness": 0.05}])
+    assert [g["key"] for g in hall.top] == [2, 1, 5]
+    assert [g["key"] for g in hall.recent] == [2, 2, 6]  # an elite can win twice
+    assert [g["key"] for g in hall.candidates()] == [2, 1, 5, 6]
+    assert HallOfFame.from_dict(hall.to_dict()).candidates() == hall.candidates()

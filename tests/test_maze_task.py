@@ -131,6 +131,7 @@ def test_kernel_matches_the_onboard_controller_cycle_by_cycle(five_maze_task, sm
                     s.mount_radius,
                     s.sector_centres,
                     s.sector_width,
+                    s.sector_tiles,
                     s.goal_bearing,
                     boxes,
                     every,

@@ -32,9 +32,16 @@ from evorbc_ros.repertoire import Repertoire
 from offline_evolution.arbitrator.compiled import pack_networks
 from offline_evolution.arbitrator.neat_config import load_neat_config
 from offline_evolution.arbitrator.neat_state import (
+    genome_from_dict,
     genome_to_dict,
     population_from_dict,
     population_to_dict,
+)
+from offline_evolution.arbitrator.selection import (
+    HallOfFame,
+    PostEvaluation,
+    post_evaluate,
+    post_evaluation_starts,
 )
 from offline_evolution.checkpoint import CheckpointError, Interrupted, settings_mismatch
 from offline_evolution.maze_task.task import (
@@ -63,6 +70,8 @@ class EvolutionSettings:
     task: dict
     mapping: str | None = None
     repertoire_fingerprint: str | None = None
+    hall_of_fame: int = 25  # genomes kept for the final post-evaluation
+    post_samples: int = 10  # random starts per maze in the post-evaluation
 
     def as_dict(self) -> dict:
         """Plain-data form (checkpoints and arbitrator files)."""
@@ -89,12 +98,20 @@ class GenerationStats:
 
 @dataclass
 class EvolutionResult:
-    """The outcome: the best genome ever seen and the per-generation history."""
+    """The outcome of a run.
+
+    ``best_*`` is the genome with the highest training fitness (the paper's figure);
+    ``selected_*`` is the hall-of-fame genome that did best in the post-evaluation, the
+    one written to the arbitrator file.
+    """
 
     settings: EvolutionSettings
     best_network: NetworkSpec
     best_fitness: float
     best_generation: int
+    selected_network: NetworkSpec
+    selected_training_fitness: float
+    post_evaluation: PostEvaluation
     history: list[GenerationStats]
     seconds: float
 
@@ -140,6 +157,7 @@ class Evolution:
         self.history: list[GenerationStats] = []
         self.best: dict | None = None  # genome_to_dict of the best genome ever
         self.best_generation = -1
+        self.hall = HallOfFame(settings.hall_of_fame)
 
     @property
     def generation(self) -> int:
@@ -163,6 +181,7 @@ class Evolution:
         reached = result.reached.reshape(len(specs), len(starts)).sum(axis=1)
         for (_, genome), f in zip(genomes, fitness, strict=True):
             genome.fitness = float(f)
+        self.hall.update([genome_to_dict(g) for _, g in genomes])
         self._eval_seconds = time.perf_counter() - start
         k = int(np.argmax(fitness))
         if self.best is None or fitness[k] > self.best["fitness"]:
@@ -190,18 +209,28 @@ class Evolution:
         self.history.append(stats)
         return stats
 
-    def result(self, seconds: float) -> EvolutionResult:
-        """The best genome as a network, with the run's history."""
-        from offline_evolution.arbitrator.neat_state import genome_from_dict
+    def network(self, genome: dict) -> NetworkSpec:
+        """A genome dict (as kept in the hall of fame) as a network."""
+        return network_spec(genome_from_dict(genome, self.config), self.config)
 
-        genome = genome_from_dict(self.best, self.config)
+    def result(self, seconds: float) -> EvolutionResult:
+        """Post-evaluate the hall of fame and assemble the run's outcome."""
+        candidates = self.hall.candidates()
+        starts = post_evaluation_starts(self.task, self.settings.seed, self.settings.post_samples)
+        post = post_evaluate(
+            self.task, self.controller, [self.network(g) for g in candidates], starts
+        )
+        chosen = candidates[post.index]
         return EvolutionResult(
-            self.settings,
-            network_spec(genome, self.config),
-            self.best["fitness"],
-            self.best_generation,
-            self.history,
-            seconds,
+            settings=self.settings,
+            best_network=self.network(self.best),
+            best_fitness=self.best["fitness"],
+            best_generation=self.best_generation,
+            selected_network=self.network(chosen),
+            selected_training_fitness=chosen["fitness"],
+            post_evaluation=post,
+            history=self.history,
+            seconds=seconds,
         )
 
     # -- checkpoints -------------------------------------------------------------------
@@ -214,6 +243,7 @@ class Evolution:
             "population": population_to_dict(self.population),
             "best": self.best,
             "best_generation": self.best_generation,
+            "hall_of_fame": self.hall.to_dict(),
             "history": [h.as_dict() for h in self.history],
             "elapsed": elapsed,
         }
@@ -238,6 +268,7 @@ class Evolution:
             self.population = population_from_dict(data["population"], self.config)
             self.best = data["best"]
             self.best_generation = int(data["best_generation"])
+            self.hall = HallOfFame.from_dict(data["hall_of_fame"])
             self.history = [GenerationStats(**h) for h in data["history"]]
             return float(data["elapsed"])
         except (KeyError, TypeError, ValueError) as e:
@@ -297,6 +328,12 @@ def arbitrator_file(
         "generations": s.generations,
         "best_fitness": result.best_fitness,
         "best_generation": result.best_generation,
+        "selected_training_fitness": result.selected_training_fitness,
+        "post_evaluation": {
+            **result.post_evaluation.as_dict(),
+            "samples_per_maze": s.post_samples,
+            "nominal_starts": True,
+        },
         "seconds": round(result.seconds, 1),
         "neat_settings": Path(s.neat_file).name,
         "neat_sha256": s.neat_sha256,
@@ -307,7 +344,7 @@ def arbitrator_file(
         return ArbitratorFile(
             kind="evorbc",
             robot=s.robot,
-            network=result.best_network,
+            network=result.selected_network,
             sensors=task.layout,
             mapping=s.mapping,
             control_period=task.dt,
@@ -322,7 +359,7 @@ def arbitrator_file(
     return ArbitratorFile(
         kind="standard",
         robot=s.robot,
-        network=result.best_network,
+        network=result.selected_network,
         sensors=task.layout,
         parameters=task.robot.parameter_specs,
         control_period=task.dt,

@@ -19,6 +19,8 @@ class ArbitratorRunSettings:
     neat: str = setting("neat/4ws.ini", doc="NEAT settings file, relative to config/")
     task: str = setting("tasks/maze-4ws.yaml", doc="task settings file, relative to config/")
     checkpoint_every: int = setting(10, doc="generations between checkpoints", minimum=1)
+    hall_of_fame: int = setting(25, doc="genomes kept for the post-evaluation", minimum=1)
+    post_samples: int = setting(10, doc="random starts per maze in the post-evaluation", minimum=0)
 
     def neat_path(self) -> Path:
         """The NEAT settings file."""

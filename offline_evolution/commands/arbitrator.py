@@ -145,6 +145,8 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         task=task_settings.as_dict(),
         mapping=(args.mapping or run.mapping) if args.kind == "evorbc" else None,
         repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
+        hall_of_fame=run.hall_of_fame,
+        post_samples=run.post_samples,
     )
     out = Path(args.out)
     plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")
@@ -185,9 +187,12 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         f"{robot}, seed {args.seed}",
     )
     label = "arbitrator" if args.kind == "evorbc" else "standard-NEAT controller"
+    post = result.post_evaluation
     print(
         f"{robot} {label}: best fitness {result.best_fitness:.3f} (generation "
-        f"{result.best_generation + 1}), {generations} generations in "
-        f"{result.seconds / 60:.1f} min (seed {args.seed}) -> {out}, curve {plot}"
+        f"{result.best_generation + 1}); the controller written scores {post.fitness:.3f} and "
+        f"reaches the target in {post.reached:.0%} of {post.episodes} post-evaluation "
+        f"episodes; {generations} generations in {result.seconds / 60:.1f} min "
+        f"(seed {args.seed}) -> {out}, curve {plot}"
     )
     return 0

@@ -106,6 +106,7 @@ def run_episodes(
     mount_radius,
     sector_centres,
     sector_width,
+    sector_tiles,
     goal_bearing,
     n_inputs,
     # controller
@@ -180,6 +181,7 @@ def run_episodes(
                 mount_radius,
                 sector_centres,
                 sector_width,
+                sector_tiles,
                 goal_bearing,
                 boxes,
                 cand,

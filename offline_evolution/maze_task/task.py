@@ -218,6 +218,7 @@ class MazeTask:
                 s.mount_radius,
                 s.sector_centres,
                 s.sector_width,
+                s.sector_tiles,
                 s.goal_bearing,
                 s.n_inputs,
                 c.mode,
