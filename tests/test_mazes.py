@@ -2,7 +2,9 @@
 
 Solvability is proved with the clearance-aware grid search of ``maze_paths`` (0.01 m cells,
 free where the clearance is >= 0.06 m), from the nominal start, from 50 seeded random starts
-and from every clear point of the start region.
+and from every clear point of the start region. The four designed mazes must be no harder than
+``obstacle``, the original authors' maze: no longer a shortest path and no longer wall-following
+paths.
 """
 
 from __future__ import annotations
@@ -27,6 +29,9 @@ from offline_evolution.plots.maze import plot_mazes
 from sim_bridge.maze import load_maze, load_named_maze, maze_from_dict, maze_names
 
 NAMES = ["baffles", "corridors", "gaps", "obstacle", "zigzag"]
+REFERENCE = "obstacle"  # the original authors' maze, the reference for difficulty
+DESIGNED = [name for name in NAMES if name != REFERENCE]
+DESIGN_GAP = 0.28  # m, the narrowest gap of a designed maze, surface to surface
 EPISODE_PATH = 16.0  # m; 120 s at 0.2 m/s is 24 m, and evolved controllers are not optimal
 TOP_SPEED_PATH = 24.0  # m, the most a robot can drive in 120 s at 0.2 m/s
 
@@ -35,6 +40,16 @@ TOP_SPEED_PATH = 24.0  # m, the most a robot can drive in 120 s at 0.2 m/s
 def solved(name: str):
     maze = load_named_maze(name)
     return maze, solve(maze)
+
+
+@functools.cache
+def followers(name: str) -> dict[str, float]:
+    return wall_followers(load_named_maze(name))
+
+
+def nominal_path(name: str) -> float:
+    maze, field = solved(name)
+    return field.distance_from(*maze.start_pose[:2])
 
 
 def test_the_five_mazes_are_shipped():
@@ -71,17 +86,37 @@ def test_maze_is_solvable_from_every_start(name, record_property):
 @pytest.mark.parametrize("name", NAMES)
 def test_maze_has_no_narrow_gaps_or_deep_dead_ends(name):
     maze, field = solved(name)
+    gap = narrowest_gap(maze)
     # 0.22 m less the grid's reading error (up to one 0.01 m cell).
-    assert narrowest_gap(maze) >= 0.21
+    assert gap >= 0.21
+    if name in DESIGNED:
+        # Less the reading error of one cell and the bisection's resolution (0.001 m).
+        assert gap >= DESIGN_GAP - 0.011
     # A goal-seeking robot never has to back away from the target by more than ~1 m.
     assert backtrack(field) <= 1.0
 
 
 @pytest.mark.parametrize("name", NAMES)
 def test_wall_followers_reach_the_target_in_an_episode(name):
-    lengths = wall_followers(load_named_maze(name))
+    lengths = followers(name)
     assert set(lengths) == {"left", "right"}
     assert max(lengths.values()) <= TOP_SPEED_PATH
+
+
+@pytest.mark.parametrize("name", DESIGNED)
+def test_designed_maze_is_no_harder_than_the_reference(name):
+    # A controller that follows walls at nearly full speed (~0.18 m/s, ~21.6 m per episode)
+    # must get through every designed maze with either hand if it gets through `obstacle`
+    # with the better one; and a planner's path must be no longer than in `obstacle`.
+    reference = min(followers(REFERENCE).values())
+    lengths = followers(name)
+    print(
+        f"{name}: wall followers L {lengths['left']:.2f} R {lengths['right']:.2f} m, "
+        f"shortest path {nominal_path(name):.2f} m; {REFERENCE}: followers >= "
+        f"{reference:.2f} m, shortest path {nominal_path(REFERENCE):.2f} m"
+    )
+    assert max(lengths.values()) <= reference
+    assert nominal_path(name) <= nominal_path(REFERENCE)
 
 
 def gaps_with_wall(wall):

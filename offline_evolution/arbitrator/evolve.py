@@ -109,6 +109,7 @@ class EvolutionResult:
     best_network: NetworkSpec
     best_fitness: float
     best_generation: int
+    best_reached: int  # mazes (episodes) the best genome reached in its evaluation
     selected_network: NetworkSpec
     selected_training_fitness: float
     post_evaluation: PostEvaluation
@@ -157,6 +158,7 @@ class Evolution:
         self.history: list[GenerationStats] = []
         self.best: dict | None = None  # genome_to_dict of the best genome ever
         self.best_generation = -1
+        self.best_reached = 0  # mazes the best genome reached in its evaluation
         self.hall = HallOfFame(settings.hall_of_fame)
 
     @property
@@ -187,6 +189,7 @@ class Evolution:
         if self.best is None or fitness[k] > self.best["fitness"]:
             self.best = genome_to_dict(genomes[k][1])
             self.best_generation = generation
+            self.best_reached = int(reached[k])
         self._gen_figures = (float(fitness[k]), float(fitness.mean()), int(reached[k]))
 
     def step(self) -> GenerationStats:
@@ -226,6 +229,7 @@ class Evolution:
             best_network=self.network(self.best),
             best_fitness=self.best["fitness"],
             best_generation=self.best_generation,
+            best_reached=self.best_reached,
             selected_network=self.network(chosen),
             selected_training_fitness=chosen["fitness"],
             post_evaluation=post,
@@ -243,6 +247,7 @@ class Evolution:
             "population": population_to_dict(self.population),
             "best": self.best,
             "best_generation": self.best_generation,
+            "best_reached": self.best_reached,
             "hall_of_fame": self.hall.to_dict(),
             "history": [h.as_dict() for h in self.history],
             "elapsed": elapsed,
@@ -268,6 +273,7 @@ class Evolution:
             self.population = population_from_dict(data["population"], self.config)
             self.best = data["best"]
             self.best_generation = int(data["best_generation"])
+            self.best_reached = int(data["best_reached"])
             self.hall = HallOfFame.from_dict(data["hall_of_fame"])
             self.history = [GenerationStats(**h) for h in data["history"]]
             return float(data["elapsed"])
@@ -328,6 +334,7 @@ def arbitrator_file(
         "generations": s.generations,
         "best_fitness": result.best_fitness,
         "best_generation": result.best_generation,
+        "best_reached": result.best_reached,
         "selected_training_fitness": result.selected_training_fitness,
         "post_evaluation": {
             **result.post_evaluation.as_dict(),
