@@ -25,8 +25,8 @@ from maze_paths import (
 )
 
 from evorbc_ros.config import ConfigError
-from offline_evolution.plots.maze import plot_mazes
 from sim_bridge.maze import load_maze, load_named_maze, maze_from_dict, maze_names
+from sim_bridge.maze_plot import plot_mazes
 
 NAMES = ["baffles", "corridors", "gaps", "obstacle", "zigzag"]
 REFERENCE = "obstacle"  # the original authors' maze, the reference for difficulty

@@ -7,7 +7,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from offline_evolution.plots.common import plt, save_figure
+from sim_bridge.plotting import plt, save_figure
 
 
 def _column(history, key: str) -> np.ndarray:

@@ -13,8 +13,8 @@ import numpy as np
 from matplotlib.collections import EllipseCollection, LineCollection
 
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.plots.common import plt, save_figure
 from offline_evolution.quality import METRICS
+from sim_bridge.plotting import plt, save_figure
 
 
 def quality_norm(repertoire: Repertoire):

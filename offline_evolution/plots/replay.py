@@ -9,8 +9,8 @@ import numpy as np
 from matplotlib.collections import LineCollection
 
 from offline_evolution.maze_task.task import EpisodeResult, MazeTask
-from offline_evolution.plots.common import plt, save_figure
-from offline_evolution.plots.maze import draw_maze
+from sim_bridge.maze_plot import draw_maze
+from sim_bridge.plotting import plt, save_figure
 
 
 def plot_trajectories(

@@ -15,7 +15,7 @@ from matplotlib.patches import Rectangle
 
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.maze_task.task import EpisodeResult
-from offline_evolution.plots.common import plt, save_figure
+from sim_bridge.plotting import plt, save_figure
 
 
 def selection_counts(result: EpisodeResult, n_primitives: int) -> np.ndarray:

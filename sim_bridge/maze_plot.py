@@ -16,9 +16,9 @@ import numpy as np
 from matplotlib.collections import PatchCollection
 from matplotlib.patches import Circle, Polygon, Rectangle
 
-from offline_evolution.plots.common import plt, save_figure
 from sim_bridge.geometry import CX, CY, EX, EY, HALF_LENGTH, HALF_THICKNESS
 from sim_bridge.maze import Maze
+from sim_bridge.plotting import plt, save_figure
 
 WALL_COLOUR = "0.25"
 START_COLOUR = "tab:blue"
@@ -115,4 +115,34 @@ def plot_mazes(mazes: Sequence[Maze], path: str | os.PathLike) -> None:
         draw_maze(ax, maze)
         w, h = maze.size()
         ax.set_title(f"{maze.name} ({w:.2f} x {h:.2f} m)", fontsize=10)
+    save_figure(fig, path)
+
+
+def plot_run(
+    maze: Maze,
+    trajectory: np.ndarray,
+    title: str,
+    path: str | os.PathLike,
+    dt: float = 0.1,
+    episode_time: float = 120.0,
+) -> None:
+    """One robot's path over its maze (colour = time), saved at ``path``."""
+    from matplotlib.collections import LineCollection
+
+    xy = np.asarray(trajectory, dtype=np.float64)[:, :2]
+    w, h = maze.size()
+    fig, ax = plt.subplots(figsize=(11.0, 11.0 * h / w + 1.2), layout="constrained")
+    draw_maze(ax, maze)
+    norm = plt.Normalize(0.0, episode_time)
+    lines = LineCollection(
+        np.stack([xy[:-1], xy[1:]], axis=1), cmap="viridis", norm=norm, linewidths=1.8, zorder=3
+    )
+    lines.set_array(np.arange(len(xy) - 1) * dt)
+    ax.add_collection(lines)
+    ax.plot(*xy[0], "o", color="tab:green", ms=5, zorder=5)
+    ax.plot(*xy[-1], "s", color="black", ms=4, zorder=5)
+    fig.colorbar(
+        plt.cm.ScalarMappable(norm=norm, cmap="viridis"), ax=ax, shrink=0.8, label="time (s)"
+    )
+    ax.set_title(title, fontsize=10)
     save_figure(fig, path)

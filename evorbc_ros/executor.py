@@ -1,0 +1,88 @@
+"""What the primitive executor commands, and when it stops the robot (pure code).
+
+The executor runs the current primitive: it turns the primitive's genes into wheel
+commands with the robot's own mapping (:mod:`evorbc_ros.robots.four_ws`). It watches when
+its inputs last arrived; if the primitive or any sensor input is older than
+``stale_timeout`` it commands zero wheel speed (steering held where it is) until they come
+back. Times are seconds on the node's clock (simulated or wall).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from evorbc_ros.laser import InputError
+from evorbc_ros.robots.four_ws import FourWSGeometry, FourWSType
+
+
+@dataclass(frozen=True)
+class WheelCommand:
+    """One command for a 4WS robot."""
+
+    steering: np.ndarray  # (4,) rad, fl, fr, rl, rr
+    speed: float  # m/s, shared by all wheels
+    stopped: bool  # True when this is the safety stop
+    reason: str = ""  # why the robot is stopped
+
+    def wheel_velocities(self, wheel_radius: float) -> np.ndarray:
+        """(4,) wheel angular velocities (rad/s) for ros2_control velocity joints."""
+        return np.full(4, self.speed / wheel_radius)
+
+
+class PrimitiveExecutor:
+    """Holds the current primitive and the freshness of every input."""
+
+    def __init__(
+        self,
+        robot: FourWSType,
+        geometry: FourWSGeometry,
+        inputs: list[str],
+        stale_timeout: float = 0.3,
+    ):
+        self.robot = robot
+        self.geometry = geometry
+        self.stale_timeout = stale_timeout
+        self.last_seen = {name: -math.inf for name in ["primitive", *inputs]}
+        self.genes: np.ndarray | None = None
+        self.steering = np.zeros(4)  # last commanded angles, held while stopped
+
+    def on_primitive(self, genes, now: float) -> None:
+        """A new primitive from the arbitrator.
+
+        Raises:
+            InputError: wrong number of genes, or values that are not finite or outside
+                [-1, 1] (the robot's genes map linearly onto its parameter ranges).
+        """
+        g = np.asarray(genes, dtype=np.float64)
+        if g.shape != (self.robot.n_parameters,):
+            raise InputError(
+                f"primitive has {g.size} values, robot {self.robot.name} expects "
+                f"{self.robot.n_parameters}"
+            )
+        if not np.all(np.isfinite(g)) or np.any(np.abs(g) > 1.0 + 1e-9):
+            raise InputError(f"primitive genes must be finite and in [-1, 1], got {g.tolist()}")
+        self.genes = g
+        self.last_seen["primitive"] = now
+
+    def on_input(self, name: str, now: float) -> None:
+        """A sensor input arrived (only its time matters here)."""
+        self.last_seen[name] = now
+
+    def stale(self, now: float) -> list[str]:
+        """Inputs older than the timeout (or never seen)."""
+        return [k for k, t in self.last_seen.items() if now - t > self.stale_timeout]
+
+    def command(self, now: float) -> WheelCommand:
+        """The command to send at time ``now``."""
+        stale = self.stale(now)
+        if stale or self.genes is None:
+            reason = (
+                "no primitive yet" if self.genes is None else f"stale input: {', '.join(stale)}"
+            )
+            return WheelCommand(self.steering.copy(), 0.0, True, reason)
+        c = self.robot.commands(self.genes, self.geometry)
+        self.steering = c[1:5].copy()
+        return WheelCommand(self.steering.copy(), float(c[0]), False)

@@ -1,0 +1,63 @@
+"""Goal-direction inputs from the robot's pose and the goal (pure code of the radar node).
+
+Poses come from odometry (``nav_msgs/Odometry``: position and orientation quaternion in a
+fixed frame) and the goal as a point in the same frame. The bearing of the goal in the body
+frame gives the goal-sector readings (4WS) or the goal-bearing reading (hexapod), with the
+formulas of :mod:`evorbc_ros.sensors`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from evorbc_ros.laser import InputError
+from evorbc_ros.sensors import SensorLayout, goal_bearing_reading, goal_sector_readings
+
+
+def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """Yaw (rad, about z) of an orientation quaternion.
+
+    Raises:
+        InputError: non-finite components or a quaternion far from unit length.
+    """
+    q = (x, y, z, w)
+    if not all(math.isfinite(v) for v in q):
+        raise InputError(f"orientation {q} is not finite")
+    norm = math.sqrt(sum(v * v for v in q))
+    if not 0.9 < norm < 1.1:
+        raise InputError(f"orientation quaternion has length {norm:.3g}, expected 1")
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+class GoalInputs:
+    """Goal-sector and goal-bearing readings of a layout."""
+
+    def __init__(self, layout: SensorLayout):
+        if layout.goal_sectors is None and not layout.goal_bearing:
+            raise ValueError("the sensor layout has no goal inputs")
+        self.layout = layout
+
+    @property
+    def names(self) -> list[str]:
+        """Names of the readings, in order."""
+        n_range = len(self.layout.rangefinders.angles) if self.layout.rangefinders else 0
+        return self.layout.input_names()[n_range:]
+
+    def readings(self, x: float, y: float, yaw: float, gx: float, gy: float) -> np.ndarray:
+        """Readings for a robot at ``(x, y, yaw)`` and a goal at ``(gx, gy)`` (one frame).
+
+        Raises:
+            InputError: a non-finite pose or goal.
+        """
+        for name, v in (("x", x), ("y", y), ("yaw", yaw), ("goal x", gx), ("goal y", gy)):
+            if not math.isfinite(v):
+                raise InputError(f"{name} is {v}, expected a finite number")
+        bearing = math.atan2(gy - y, gx - x) - yaw
+        out = []
+        if self.layout.goal_sectors is not None:
+            out.extend(goal_sector_readings(bearing, self.layout.goal_sectors))
+        if self.layout.goal_bearing:
+            out.append(goal_bearing_reading(bearing))
+        return np.array(out, dtype=np.float64)

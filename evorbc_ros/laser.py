@@ -1,0 +1,111 @@
+"""Rangefinder inputs from any ``sensor_msgs/LaserScan`` (pure code of the laser node).
+
+The arbitrator was evolved with rangefinders mounted on the body's edge (see
+:mod:`evorbc_ros.sensors`); a real robot has a laser scanner somewhere on its body. Each
+beam's hit point is moved into the robot's body frame (x forward, y left) using the
+scanner's pose on the robot, and then belongs to the rangefinders whose field of view
+contains its direction from the body centre. A rangefinder reads its nearest beam::
+
+    d = |hit - centre| - mount_radius       (distance from the mount point)
+
+With a field of view of 0 (one ray), the rangefinder takes the beam whose direction is
+nearest its axis, if that beam is within half a beam spacing of it.
+
+Range values follow REP 117: ``+inf`` is no return within range (nothing seen), ``-inf``
+is an object closer than ``range_min`` (touching), NaN is an invalid measurement (the beam
+is skipped). Finite values below ``range_min`` are invalid; above ``range_max`` they are
+no return.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from evorbc_ros.sensors import RangefinderLayout, range_reading
+
+
+class InputError(ValueError):
+    """A message cannot be used; the text says what is wrong with it."""
+
+
+@dataclass(frozen=True)
+class LaserPose:
+    """Where the scanner sits on the robot: position (m) and yaw (rad) in the body frame."""
+
+    x: float = 0.0
+    y: float = 0.0
+    yaw: float = 0.0
+
+
+def _wrap(angle: np.ndarray) -> np.ndarray:
+    return np.mod(angle + np.pi, 2.0 * np.pi) - np.pi
+
+
+class LaserToRangefinders:
+    """Turns LaserScan ranges into the configured rangefinder readings."""
+
+    def __init__(self, layout: RangefinderLayout, pose: LaserPose = LaserPose()):
+        self.layout = layout
+        self.pose = pose
+        self.axes = np.asarray(layout.angles, dtype=np.float64)  # (n,) body frame, rad
+
+    def readings(
+        self, angle_min: float, angle_increment: float, ranges, range_min: float, range_max: float
+    ) -> np.ndarray:
+        """Rangefinder readings in [0, 1] from one scan.
+
+        Raises:
+            InputError: a malformed scan (non-finite or zero increment, non-finite angles or
+                limits, no beams).
+        """
+        r = np.asarray(ranges, dtype=np.float64)
+        for name, value in (
+            ("angle_min", angle_min),
+            ("angle_increment", angle_increment),
+            ("range_min", range_min),
+            ("range_max", range_max),
+        ):
+            if not math.isfinite(value):
+                raise InputError(f"{name} is {value}, expected a finite number")
+        if angle_increment == 0.0:
+            raise InputError("angle_increment is 0: beam directions are undefined")
+        if r.ndim != 1 or r.size == 0:
+            raise InputError("the scan has no ranges")
+        if range_max <= 0 or range_min < 0 or range_min > range_max:
+            raise InputError(f"range limits [{range_min}, {range_max}] are not valid")
+
+        beam = angle_min + angle_increment * np.arange(r.size)  # laser frame, rad
+        valid = ~np.isnan(r) & ~(np.isfinite(r) & (r < range_min))
+        touching = np.isneginf(r)
+        seen = valid & np.isfinite(r) & (r <= range_max)
+        dist = np.where(seen, r, np.inf)
+        dist = np.where(touching, 0.0, dist)
+        # Hit points in the body frame. A beam's direction from the body centre comes from
+        # its hit point; beams with no return or a zero range use a point 1 m along the beam.
+        heading = beam + self.pose.yaw
+        cos, sin = np.cos(heading), np.sin(heading)
+        finite = np.isfinite(dist)
+        along = np.where(finite & (dist > 0.0), dist, 1.0)
+        direction = np.arctan2(self.pose.y + along * sin, self.pose.x + along * cos)
+        hx = self.pose.x + np.where(finite, dist, 0.0) * cos
+        hy = self.pose.y + np.where(finite, dist, 0.0) * sin
+        from_centre = np.where(finite, np.hypot(hx, hy), np.inf)
+        from_mount = np.maximum(from_centre - self.layout.mount_radius, 0.0)
+
+        out = np.empty(len(self.axes))
+        half_fov = 0.5 * self.layout.field_of_view
+        half_gap = 0.5 * abs(angle_increment)
+        for k, axis in enumerate(self.axes):
+            offset = np.abs(_wrap(direction - axis))
+            if half_fov > 0.0:
+                members = valid & (offset <= half_fov + 1e-12)
+                d = np.min(from_mount[members], initial=np.inf)
+            else:
+                candidates = np.where(valid, offset, np.inf)
+                j = int(np.argmin(candidates))
+                d = from_mount[j] if candidates[j] <= half_gap + 1e-12 else np.inf
+            out[k] = range_reading(d, self.layout.max_range)
+        return out

@@ -1,0 +1,131 @@
+"""``arbitrator``: sensor readings -> network -> mapping -> primitive.
+
+Subscribes ``evorbc/rangefinders`` and ``evorbc/goal_sectors`` (Float64MultiArray); once
+both have a new message it publishes the chosen primitive's genes on ``evorbc/primitive``
+(Float64MultiArray, labelled with the parameter names) and, for EvoRBC, the diagnostic
+``evorbc/mapping`` = ``[m1, m2, x, y, primitive index]``. By default it runs the arbitrator
+and repertoire shipped with the package, so ``ros2 run evorbc_ros arbitrator`` needs no
+arguments. Bad files or a repertoire/sensor mismatch stop it at start-up with one line.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from rclpy.node import Node
+from std_msgs.msg import Float64MultiArray
+
+from evorbc_ros.arbitration import Controller, InputGroups
+from evorbc_ros.arbitrator import ArbitratorError
+from evorbc_ros.laser import InputError
+from evorbc_ros.nodes.common import (
+    RELIABLE,
+    StartupError,
+    declare,
+    load_sensor_layout,
+    run_node,
+    vector_message,
+    vector_values,
+)
+from evorbc_ros.repertoire import RepertoireError
+
+
+class ArbitratorNode(Node):
+    """Chooses a primitive whenever a full set of new readings has arrived."""
+
+    def __init__(self) -> None:
+        super().__init__("arbitrator")
+        arbitrator = declare(
+            self, "arbitrator", "", "arbitrator file (JSON); empty: the shipped 4ws-5 arbitrator"
+        )
+        repertoire = declare(
+            self, "repertoire", "", "repertoire file (JSON); empty: the shipped one for its robot"
+        )
+        allow = declare(
+            self,
+            "allow_mismatch",
+            False,
+            "run with a repertoire or sensor layout other than the arbitrator's",
+        )
+        layout_path = declare(
+            self,
+            "sensor_layout",
+            "",
+            "the sensor nodes' layout (YAML); empty: the arbitrator's own",
+        )
+        try:
+            self.controller = Controller(arbitrator, repertoire, allow)
+            spec = self.controller.spec
+            if layout_path:
+                self.controller.warnings += spec.check_sensors(
+                    load_sensor_layout(layout_path), layout_path, allow
+                )
+        except (ArbitratorError, RepertoireError) as e:
+            raise StartupError(str(e)) from None
+        for w in self.controller.warnings:
+            self.get_logger().warning(w)
+        rf_topic = declare(
+            self,
+            "rangefinder_topic",
+            "evorbc/rangefinders",
+            "rangefinder readings (Float64MultiArray)",
+        )
+        goal_topic = declare(
+            self, "goal_topic", "evorbc/goal_sectors", "goal readings (Float64MultiArray)"
+        )
+        out_topic = declare(
+            self,
+            "primitive_topic",
+            "evorbc/primitive",
+            "chosen primitive's genes (Float64MultiArray)",
+        )
+        map_topic = declare(
+            self,
+            "mapping_topic",
+            "evorbc/mapping",
+            "diagnostics [m1, m2, x, y, primitive] (Float64MultiArray)",
+        )
+        layout = spec.sensors
+        n_rf = len(layout.rangefinders.angles) if layout.rangefinders else 0
+        sizes = {rf_topic: n_rf, goal_topic: layout.n_inputs - n_rf}
+        self.groups = InputGroups({k: v for k, v in sizes.items() if v > 0})
+        self.pub = self.create_publisher(Float64MultiArray, out_topic, RELIABLE)
+        self.map_pub = self.create_publisher(Float64MultiArray, map_topic, RELIABLE)
+        self.subs = [
+            self.create_subscription(
+                Float64MultiArray, topic, lambda msg, t=topic: self.on_input(t, msg), RELIABLE
+            )
+            for topic in self.groups.sizes
+        ]
+        self.get_logger().info(
+            f"{spec.kind} controller for {spec.robot} from {self.controller.arbitrator_path}"
+            + (
+                f" over {self.controller.repertoire_path} "
+                f"({len(self.controller.repertoire)} primitives)"
+                if self.controller.repertoire is not None
+                else ""
+            )
+        )
+
+    def on_input(self, topic: str, msg: Float64MultiArray) -> None:
+        """Store one input group; choose once all are new."""
+        try:
+            values = vector_values(msg, self.groups.sizes[topic], topic)
+        except InputError as e:
+            self.get_logger().warning(f"skipped a message: {e}", throttle_duration_sec=2.0)
+            return
+        if not self.groups.put(topic, values):
+            return
+        genes, diagnostics = self.controller.step(self.groups.take())
+        self.pub.publish(vector_message(genes, self.controller.parameter_names))
+        if diagnostics:
+            self.map_pub.publish(vector_message(diagnostics, ["m1", "m2", "x", "y", "primitive"]))
+
+
+def main(argv=None) -> int:
+    """Run the node."""
+    return run_node(ArbitratorNode, argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,133 @@
+"""Shared pieces of the evorbc ROS 2 nodes: QoS, vector messages, start-up and main().
+
+Conventions (DESIGN.md section 9): sensor streams from other stacks are subscribed with
+``qos_profile_sensor_data``; everything evorbc publishes is reliable (a best-effort
+subscriber still receives it); the goal is latched (transient local) so a node that starts
+late still gets it.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Sequence
+
+import numpy as np
+import rclpy
+from rclpy.node import Node
+from rclpy.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    QoSProfile,
+    ReliabilityPolicy,
+    qos_profile_sensor_data,
+)
+from std_msgs.msg import Float64MultiArray, MultiArrayDimension
+
+#: Our own streams: reliable, keep the last 10 (no loss in lockstep on one machine).
+RELIABLE = QoSProfile(
+    depth=10, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST
+)
+#: Latched topics (the goal): late joiners get the last message.
+LATCHED = QoSProfile(
+    depth=1,
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    history=HistoryPolicy.KEEP_LAST,
+)
+SENSOR_DATA = qos_profile_sensor_data
+
+
+class StartupError(Exception):
+    """A node cannot start (bad parameter or file); the message says which and why."""
+
+
+def vector_message(values: Sequence[float], names: Sequence[str] = ()) -> Float64MultiArray:
+    """A Float64MultiArray of ``values``; ``names`` go into the dimension label (comma list)."""
+    msg = Float64MultiArray()
+    msg.layout.dim = [
+        MultiArrayDimension(label=",".join(names), size=len(values), stride=len(values))
+    ]
+    msg.data = [float(v) for v in values]
+    return msg
+
+
+def vector_values(msg: Float64MultiArray, expected: int, topic: str) -> np.ndarray:
+    """The values of a vector message, checked for length and finiteness.
+
+    Raises:
+        evorbc_ros.laser.InputError: naming the topic and the problem.
+    """
+    from evorbc_ros.laser import InputError
+
+    values = np.asarray(msg.data, dtype=np.float64)
+    if values.shape != (expected,):
+        raise InputError(f"{topic}: expected {expected} values, got {values.size}")
+    if not np.all(np.isfinite(values)):
+        raise InputError(f"{topic}: values must be finite, got {values.tolist()}")
+    return values
+
+
+def now_seconds(node: Node) -> float:
+    """The node's clock (simulated when ``use_sim_time`` is set) in seconds."""
+    return node.get_clock().now().nanoseconds * 1e-9
+
+
+def run_node(make: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
+    """Init / construct / spin / destroy / try_shutdown, with one-line start-up errors."""
+    rclpy.init(args=argv)
+    node = None
+    try:
+        node = make()
+        rclpy.spin(node)
+    except StartupError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        pass
+    except rclpy.executors.ExternalShutdownException:
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+def declare(node: Node, name: str, default, description: str):
+    """Declare a parameter with a description and return its value."""
+    from rcl_interfaces.msg import ParameterDescriptor
+
+    return node.declare_parameter(name, default, ParameterDescriptor(description=description)).value
+
+
+def load_sensor_layout(path: str):
+    """The sensor layout from a layout YAML, an arbitrator file, or the shipped 4WS layout.
+
+    Raises:
+        StartupError: naming the file and the problem.
+    """
+    from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
+    from evorbc_ros.config import ConfigError, config_dir
+    from evorbc_ros.sensors import SensorLayout
+
+    try:
+        if not path:
+            return SensorLayout.load(config_dir() / "sensors" / "4ws.yaml")
+        if path.endswith(".json"):
+            return ArbitratorFile.load(path).sensors
+        return SensorLayout.load(path)
+    except (ConfigError, ArbitratorError) as e:
+        raise StartupError(f"parameter sensor_layout: {e}") from None
+
+
+def finite_parameter(
+    node: Node, name: str, default: float, description: str, positive: bool = False
+) -> float:
+    """Declare a float parameter and check it is finite (and > 0 if ``positive``)."""
+    import math
+
+    value = declare(node, name, float(default), description)
+    if not isinstance(value, (int, float)) or not math.isfinite(value) or (positive and value <= 0):
+        need = "a positive number" if positive else "a finite number"
+        raise StartupError(f"parameter {name} must be {need}, got {value!r}")
+    return float(value)

@@ -1,0 +1,79 @@
+"""``laser_sensor``: any sensor_msgs/LaserScan -> the arbitrator's rangefinder readings.
+
+Subscribes ``scan`` (LaserScan, sensor-data QoS) and publishes ``evorbc/rangefinders``
+(std_msgs/Float64MultiArray, reliable): one reading in [0, 1] per configured rangefinder,
+labelled with the input names. Malformed scans are logged and skipped.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from rclpy.node import Node
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import Float64MultiArray
+
+from evorbc_ros.laser import InputError, LaserPose, LaserToRangefinders
+from evorbc_ros.nodes.common import (
+    RELIABLE,
+    SENSOR_DATA,
+    StartupError,
+    declare,
+    finite_parameter,
+    load_sensor_layout,
+    run_node,
+    vector_message,
+)
+
+
+class LaserSensorNode(Node):
+    """Converts each scan into rangefinder readings."""
+
+    def __init__(self) -> None:
+        super().__init__("laser_sensor")
+        layout = load_sensor_layout(
+            declare(
+                self,
+                "sensor_layout",
+                "",
+                "sensor layout YAML or arbitrator JSON; empty: the shipped 4WS layout",
+            )
+        )
+        if layout.rangefinders is None:
+            raise StartupError("parameter sensor_layout: the layout has no rangefinders")
+        pose = LaserPose(
+            finite_parameter(self, "laser_x", 0.0, "scanner position on the robot, x (m)"),
+            finite_parameter(self, "laser_y", 0.0, "scanner position on the robot, y (m)"),
+            finite_parameter(self, "laser_yaw", 0.0, "scanner yaw in the robot frame (rad)"),
+        )
+        self.scan_topic = declare(self, "scan_topic", "scan", "input LaserScan topic")
+        out_topic = declare(
+            self, "output_topic", "evorbc/rangefinders", "output topic (Float64MultiArray)"
+        )
+        self.converter = LaserToRangefinders(layout.rangefinders, pose)
+        n = len(layout.rangefinders.angles)
+        self.names = layout.input_names()[:n]
+        self.pub = self.create_publisher(Float64MultiArray, out_topic, RELIABLE)
+        self.sub = self.create_subscription(LaserScan, self.scan_topic, self.on_scan, SENSOR_DATA)
+
+    def on_scan(self, msg: LaserScan) -> None:
+        """Publish the readings of one scan, or log why it was skipped."""
+        try:
+            readings = self.converter.readings(
+                msg.angle_min, msg.angle_increment, msg.ranges, msg.range_min, msg.range_max
+            )
+        except InputError as e:
+            self.get_logger().warning(
+                f"{self.scan_topic}: skipped a scan: {e}", throttle_duration_sec=2.0
+            )
+            return
+        self.pub.publish(vector_message(readings, self.names))
+
+
+def main(argv=None) -> int:
+    """Run the node."""
+    return run_node(LaserSensorNode, argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,108 @@
+"""``radar_sensor``: robot pose and goal -> goal-sector (4WS) or goal-bearing readings.
+
+Subscribes ``odom`` (nav_msgs/Odometry, sensor-data QoS) and ``goal``
+(geometry_msgs/PointStamped, or PoseStamped with ``goal_type: pose``; latched); publishes
+``evorbc/goal_sectors`` (std_msgs/Float64MultiArray, reliable) on every odometry message
+once a goal is known. The goal must be in the odometry's frame (no tf here); messages with
+NaN poses or another frame are logged and skipped.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from geometry_msgs.msg import PointStamped, PoseStamped
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from std_msgs.msg import Float64MultiArray
+
+from evorbc_ros.goal import GoalInputs, yaw_from_quaternion
+from evorbc_ros.laser import InputError
+from evorbc_ros.nodes.common import (
+    LATCHED,
+    RELIABLE,
+    SENSOR_DATA,
+    StartupError,
+    declare,
+    load_sensor_layout,
+    run_node,
+    vector_message,
+)
+
+
+class RadarSensorNode(Node):
+    """Publishes goal-direction readings for every pose."""
+
+    def __init__(self) -> None:
+        super().__init__("radar_sensor")
+        layout = load_sensor_layout(
+            declare(
+                self,
+                "sensor_layout",
+                "",
+                "sensor layout YAML or arbitrator JSON; empty: the shipped 4WS layout",
+            )
+        )
+        try:
+            self.inputs = GoalInputs(layout)
+        except ValueError as e:
+            raise StartupError(f"parameter sensor_layout: {e}") from None
+        self.odom_topic = declare(self, "odom_topic", "odom", "input Odometry topic")
+        self.goal_topic = declare(self, "goal_topic", "goal", "goal topic (latched)")
+        goal_type = declare(self, "goal_type", "point", "goal message type: point or pose")
+        if goal_type not in ("point", "pose"):
+            raise StartupError(f"parameter goal_type must be 'point' or 'pose', got {goal_type!r}")
+        out_topic = declare(
+            self, "output_topic", "evorbc/goal_sectors", "output topic (Float64MultiArray)"
+        )
+        self.goal: tuple[float, float, str] | None = None
+        self.pub = self.create_publisher(Float64MultiArray, out_topic, RELIABLE)
+        msg_type = PointStamped if goal_type == "point" else PoseStamped
+        self.goal_sub = self.create_subscription(msg_type, self.goal_topic, self.on_goal, LATCHED)
+        self.odom_sub = self.create_subscription(
+            Odometry, self.odom_topic, self.on_odom, SENSOR_DATA
+        )
+
+    def on_goal(self, msg) -> None:
+        """Remember the goal (point, or a pose's position)."""
+        p = msg.point if isinstance(msg, PointStamped) else msg.pose.position
+        goal = (p.x, p.y, msg.header.frame_id)
+        if goal != self.goal:
+            self.get_logger().info(f"goal ({p.x:.3f}, {p.y:.3f}) in frame '{msg.header.frame_id}'")
+        self.goal = goal
+
+    def on_odom(self, msg: Odometry) -> None:
+        """Publish the readings for this pose."""
+        if self.goal is None:
+            self.get_logger().info(
+                f"waiting for a goal on {self.goal_topic}", throttle_duration_sec=5.0
+            )
+            return
+        gx, gy, frame = self.goal
+        if frame and msg.header.frame_id and frame != msg.header.frame_id:
+            self.get_logger().warning(
+                f"{self.odom_topic}: frame '{msg.header.frame_id}' differs from the goal's "
+                f"'{frame}'; skipped (publish the goal in the odometry frame)",
+                throttle_duration_sec=5.0,
+            )
+            return
+        pose = msg.pose.pose
+        try:
+            q = pose.orientation
+            yaw = yaw_from_quaternion(q.x, q.y, q.z, q.w)
+            readings = self.inputs.readings(pose.position.x, pose.position.y, yaw, gx, gy)
+        except InputError as e:
+            self.get_logger().warning(
+                f"{self.odom_topic}: skipped a pose: {e}", throttle_duration_sec=2.0
+            )
+            return
+        self.pub.publish(vector_message(readings, self.inputs.names))
+
+
+def main(argv=None) -> int:
+    """Run the node."""
+    return run_node(RadarSensorNode, argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

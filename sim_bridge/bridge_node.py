@@ -1,0 +1,325 @@
+"""``sim_bridge``: the PyBullet-backed simulated robot and maze as a ROS 2 node.
+
+Publishes ``/clock`` (rosgraph_msgs/Clock, simulated time), ``scan``
+(sensor_msgs/LaserScan, frame ``base_link``), ``odom`` (nav_msgs/Odometry, ``odom`` ->
+``base_link``), ``goal`` (geometry_msgs/PointStamped in ``odom``, latched) and
+``joint_states`` (sensor_msgs/JointState: four steering and four wheel joints). Applies the
+ros2_control commands ``steering_position_controller/commands`` (rad) and
+``wheel_velocity_controller/commands`` (rad/s; the robot's single wheel speed is their
+mean times the wheel radius).
+
+Modes:
+* ``lockstep``: publish the state, wait for one new message on both command topics, step
+  0.1 s, repeat: deterministic and as fast as the graph answers. If no command comes within
+  ``lockstep_timeout`` s of wall time the state is published again (a restarted node then
+  picks the run up where it was).
+* ``realtime``: step every 0.1 s of wall time with the latest commands.
+
+The episode ends at the target or after ``episode_time``; the result (reached, time,
+eq. 5 fitness, trajectory) is logged and, if ``result_file`` is set, written as JSON.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import time
+
+import numpy as np
+import rclpy
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import PointStamped
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState, LaserScan
+from std_msgs.msg import Float64MultiArray
+
+from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.config import ConfigError
+from evorbc_ros.nodes.common import (
+    LATCHED,
+    RELIABLE,
+    StartupError,
+    declare,
+    finite_parameter,
+)
+from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES
+from sim_bridge.maze import load_named_maze
+from sim_bridge.world import LaserConfig, SimWorld
+
+STEERING_JOINTS = [f"{w}_steering_joint" for w in WHEEL_NAMES]
+WHEEL_JOINTS = [f"{w}_wheel_joint" for w in WHEEL_NAMES]
+
+
+def stamp(seconds: float) -> Time:
+    """A builtin_interfaces/Time for ``seconds``."""
+    ns = round(seconds * 1e9)
+    return Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+
+
+class SimBridgeNode(Node):
+    """The simulated 4WS robot in a maze."""
+
+    def __init__(self) -> None:
+        super().__init__("sim_bridge")
+        maze_name = declare(self, "maze", "obstacle", "maze name or maze YAML file")
+        robot = declare(self, "robot", "4ws-5", "robot type")
+        self.mode = declare(self, "mode", "lockstep", "lockstep or realtime")
+        gui = declare(self, "gui", False, "open the PyBullet GUI window")
+        start = declare(self, "start", "nominal", "nominal, random, or 'x,y,heading_deg'")
+        seed = declare(self, "seed", 0, "seed of a random start")
+        episode_time = finite_parameter(
+            self, "episode_time", 120.0, "episode length T (s)", positive=True
+        )
+        self.wheel_radius = finite_parameter(
+            self, "wheel_radius", 0.02, "wheel radius (m)", positive=True
+        )
+        laser = LaserConfig(
+            beams=declare(self, "laser_beams", 360, "laser beams per scan"),
+            range_max=finite_parameter(self, "laser_range", 2.0, "laser range (m)", positive=True),
+        )
+        self.lockstep_timeout = finite_parameter(
+            self,
+            "lockstep_timeout",
+            0.5,
+            "wall seconds before the state is sent again",
+            positive=True,
+        )
+        self.result_file = declare(self, "result_file", "", "write the result here (JSON)")
+        self.progress_period = finite_parameter(
+            self, "progress_period", 10.0, "simulated seconds between progress lines", positive=True
+        )
+        if self.mode not in ("lockstep", "realtime"):
+            raise StartupError(f"parameter mode must be lockstep or realtime, got {self.mode!r}")
+        if robot not in ROBOT_TYPES:
+            raise StartupError(f"parameter robot must be one of {', '.join(ROBOT_TYPES)}")
+        if laser.beams < 1:
+            raise StartupError("parameter laser_beams must be at least 1")
+        try:
+            maze = load_named_maze(maze_name)
+        except ConfigError as e:
+            raise StartupError(f"parameter maze: {e}") from None
+        pose = self._start_pose(maze, start, seed)
+        self.world = SimWorld(maze, robot, pose, episode_time, laser, gui)
+        self.trajectory = [list(self.world.pose)]
+        self.commands = {"steering": None, "wheel": None}
+        self.fresh = {"steering": False, "wheel": False}
+
+        self.clock_pub = self.create_publisher(Clock, "/clock", RELIABLE)
+        self.scan_pub = self.create_publisher(LaserScan, "scan", RELIABLE)
+        self.odom_pub = self.create_publisher(Odometry, "odom", RELIABLE)
+        self.joint_pub = self.create_publisher(JointState, "joint_states", RELIABLE)
+        self.goal_pub = self.create_publisher(PointStamped, "goal", LATCHED)
+        steering_topic = declare(
+            self,
+            "steering_topic",
+            "steering_position_controller/commands",
+            "steering command topic",
+        )
+        wheel_topic = declare(
+            self, "wheel_topic", "wheel_velocity_controller/commands", "wheel command topic"
+        )
+        self.subs = [
+            self.create_subscription(
+                Float64MultiArray,
+                steering_topic,
+                lambda m: self.on_command("steering", m),
+                RELIABLE,
+            ),
+            self.create_subscription(
+                Float64MultiArray, wheel_topic, lambda m: self.on_command("wheel", m), RELIABLE
+            ),
+        ]
+        self.next_progress = self.progress_period
+        goal = PointStamped()  # latched: published once, late joiners still get it
+        goal.header.frame_id = "odom"
+        goal.point.x, goal.point.y = self.world.maze.target
+        self.goal_pub.publish(goal)
+        self.get_logger().info(
+            f"{robot} in maze {maze.name} ({self.mode}), start "
+            f"({pose[0]:.3f}, {pose[1]:.3f}, {math.degrees(pose[2]):.1f} deg)"
+        )
+
+    @staticmethod
+    def _start_pose(maze, start: str, seed: int) -> tuple[float, float, float]:
+        if start == "nominal":
+            return maze.start_pose
+        if start == "random":
+            return tuple(maze.sample_starts(np.random.default_rng(seed), 1, 0.05)[0])
+        try:
+            x, y, h = (float(v) for v in start.split(","))
+        except ValueError:
+            raise StartupError(
+                f"parameter start must be nominal, random or 'x,y,heading_deg', got {start!r}"
+            ) from None
+        if not all(math.isfinite(v) for v in (x, y, h)):
+            raise StartupError(f"parameter start must be finite, got {start!r}")
+        return x, y, math.radians(h)
+
+    # -- commands ----------------------------------------------------------------------
+
+    def on_command(self, which: str, msg: Float64MultiArray) -> None:
+        """Store a command if it has four finite values."""
+        values = np.asarray(msg.data, dtype=np.float64)
+        if values.shape != (4,) or not np.all(np.isfinite(values)):
+            self.get_logger().warning(
+                f"{which} command must be 4 finite values, got {values.tolist()}; ignored",
+                throttle_duration_sec=2.0,
+            )
+            return
+        self.commands[which] = values
+        self.fresh[which] = True
+
+    def wheel_command(self) -> np.ndarray:
+        """``(speed m/s, fl, fr, rl, rr rad)`` from the latest commands (stopped if none)."""
+        steering = self.commands["steering"]
+        wheel = self.commands["wheel"]
+        if steering is None:
+            steering = self.world.steering
+        speed = 0.0 if wheel is None else float(np.mean(wheel)) * self.wheel_radius
+        return np.concatenate([[speed], steering])
+
+    # -- publishing --------------------------------------------------------------------
+
+    def publish_state(self) -> None:
+        """Clock, scan, odometry and joint states at the current simulated time."""
+        t = stamp(self.world.time)
+        self.clock_pub.publish(Clock(clock=t))
+        laser = self.world.laser
+        scan = LaserScan()
+        scan.header.stamp = t
+        scan.header.frame_id = "base_link"
+        scan.angle_min = laser.angle_min
+        scan.angle_max = laser.angle_min + laser.increment * (laser.beams - 1)
+        scan.angle_increment = laser.increment
+        scan.range_min = laser.range_min
+        scan.range_max = laser.range_max
+        scan.ranges = [float(r) for r in self.world.scan()]
+        self.scan_pub.publish(scan)
+        x, y, h = self.world.pose
+        odom = Odometry()
+        odom.header.stamp = t
+        odom.header.frame_id = "odom"
+        odom.child_frame_id = "base_link"
+        odom.pose.pose.position.x = x
+        odom.pose.pose.position.y = y
+        odom.pose.pose.orientation.z = math.sin(0.5 * h)
+        odom.pose.pose.orientation.w = math.cos(0.5 * h)
+        odom.twist.twist.linear.x = self.world.speed
+        self.odom_pub.publish(odom)
+        joints = JointState()
+        joints.header.stamp = t
+        joints.name = STEERING_JOINTS + WHEEL_JOINTS
+        joints.position = [*self.world.steering.tolist(), *self.world.wheel_angle.tolist()]
+        joints.velocity = [0.0] * 4 + [self.world.speed / self.wheel_radius] * 4
+        self.joint_pub.publish(joints)
+
+    def advance(self) -> None:
+        """Step the world with the latest commands and log progress."""
+        self.world.step(self.wheel_command(), self.wheel_radius)
+        self.trajectory.append(list(self.world.pose))
+        status = self.world.status()
+        if status.time >= self.next_progress - 1e-9:
+            self.next_progress += self.progress_period
+            self.get_logger().info(
+                f"t = {status.time:5.1f} s, {status.distance:.2f} m to the target"
+            )
+
+    # -- running -----------------------------------------------------------------------
+
+    def run_lockstep(self) -> None:
+        """The lockstep loop: state out, both commands in, step."""
+        executor = rclpy.executors.SingleThreadedExecutor()
+        executor.add_node(self)
+        try:
+            while not self.world.status().done and rclpy.ok():
+                self.fresh = {"steering": False, "wheel": False}
+                self.publish_state()
+                sent = time.monotonic()
+                while not all(self.fresh.values()) and rclpy.ok():
+                    executor.spin_once(timeout_sec=0.01)
+                    if time.monotonic() - sent > self.lockstep_timeout:
+                        self.get_logger().info(
+                            f"no command for t = {self.world.time:.1f} s "
+                            "yet; sending the state again",
+                            throttle_duration_sec=5.0,
+                        )
+                        self.publish_state()
+                        sent = time.monotonic()
+                self.advance()
+            self.publish_state()  # final state for listeners
+        finally:
+            executor.remove_node(self)
+
+    def run_realtime(self) -> None:
+        """Step every 0.1 s of wall time with whatever commands are current."""
+        executor = rclpy.executors.SingleThreadedExecutor()
+        executor.add_node(self)
+        period = self.world.limits.dt
+        try:
+            self.publish_state()
+            next_tick = time.monotonic() + period
+            while not self.world.status().done and rclpy.ok():
+                executor.spin_once(timeout_sec=max(0.0, next_tick - time.monotonic()))
+                if time.monotonic() >= next_tick:
+                    next_tick += period
+                    self.advance()
+                    self.publish_state()
+        finally:
+            executor.remove_node(self)
+
+    def finish(self) -> dict:
+        """Log the result and write the result file."""
+        s = self.world.status()
+        result = {
+            "maze": self.world.maze.name,
+            "robot": self.world.type.name,
+            "reached": s.reached,
+            "time": round(s.time, 3),
+            "fitness": s.fitness,
+            "final_distance": s.distance,
+            "initial_distance": s.initial_distance,
+            "episode_time": s.episode_time,
+            "mode": self.mode,
+            "trajectory": self.trajectory,
+        }
+        verdict = (
+            f"reached the target in {s.time:.1f} s"
+            if s.reached
+            else (f"did not reach the target ({s.distance:.2f} m left after {s.time:.1f} s)")
+        )
+        self.get_logger().info(f"{verdict}; fitness {s.fitness:.3f}")
+        if self.result_file:
+            atomic_write_text(self.result_file, json.dumps(result))
+        return result
+
+
+def main(argv=None) -> int:
+    """Run one episode and exit."""
+    rclpy.init(args=argv)
+    node = None
+    try:
+        node = SimBridgeNode()
+        if node.mode == "lockstep":
+            node.run_lockstep()
+        else:
+            node.run_realtime()
+        node.finish()
+    except StartupError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
+        if node is not None:
+            node.finish()
+    finally:
+        if node is not None:
+            node.world.close()
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,207 @@
+"""``evorbc-sim``: bring up the simulated graph as separate processes, without ``launch``.
+
+Starts ``sim_bridge`` and the four evorbc nodes (``laser_sensor``, ``radar_sensor``,
+``arbitrator``, ``primitive_executor``) as processes on this machine, runs one maze
+episode, prints the result, writes a trajectory picture, and shuts everything down; Ctrl-C
+stops the run cleanly. The same graph comes up with ``ros2 launch evorbc_ros sim.launch.py``
+for users who have ROS 2's launch.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
+from evorbc_ros.config import ConfigError
+from evorbc_ros.defaults import default_arbitrator
+from sim_bridge.maze import load_named_maze, maze_names
+
+NODES = {
+    "laser_sensor": "evorbc_ros.nodes.laser_sensor",
+    "radar_sensor": "evorbc_ros.nodes.radar_sensor",
+    "arbitrator": "evorbc_ros.nodes.arbitrator",
+    "primitive_executor": "evorbc_ros.nodes.primitive_executor",
+}
+
+
+def parse_args(argv=None) -> argparse.Namespace:
+    """Command-line options of ``evorbc-sim``."""
+    p = argparse.ArgumentParser(
+        prog="evorbc-sim",
+        description="Run an evolved controller through the ROS 2 graph "
+        "against the PyBullet simulation bridge, one maze episode.",
+    )
+    p.add_argument(
+        "--maze",
+        default="obstacle",
+        help=f"maze name ({', '.join(maze_names())}) or file (default: obstacle)",
+    )
+    p.add_argument("--arbitrator", default="", help="arbitrator file (default: the shipped one)")
+    p.add_argument("--repertoire", default="", help="its repertoire (default: the shipped one)")
+    p.add_argument(
+        "--mode",
+        choices=("lockstep", "realtime"),
+        default="lockstep",
+        help="lockstep: deterministic and fast (default); realtime: 10 Hz wall clock",
+    )
+    p.add_argument("--start", default="nominal", help="nominal, random or 'x,y,heading_deg'")
+    p.add_argument("--seed", type=int, default=0, help="seed of a random start")
+    p.add_argument("--gui", action="store_true", help="open the PyBullet window")
+    p.add_argument("--plot", default="", help="trajectory picture (default: <maze>-run.png)")
+    p.add_argument("--result", default="", help="also keep the result as JSON here")
+    p.add_argument(
+        "--domain-id",
+        type=int,
+        default=None,
+        help="ROS_DOMAIN_ID for the graph (default: the environment's, else 0)",
+    )
+    p.add_argument("--quiet", action="store_true", help="only the result line")
+    return p.parse_args(argv)
+
+
+def node_command(module: str, params: dict) -> list[str]:
+    """``python -m module --ros-args -p k:=v ...``."""
+    cmd = [sys.executable, "-m", module, "--ros-args"]
+    for key, value in params.items():
+        text = str(value).lower() if isinstance(value, bool) else str(value)
+        cmd += ["-p", f"{key}:={text}"]
+    return cmd
+
+
+class Graph:
+    """The processes of one run; stops them all on exit."""
+
+    def __init__(self, env: dict, quiet: bool) -> None:
+        self.env = env
+        self.quiet = quiet
+        self.procs: dict[str, subprocess.Popen] = {}
+
+    def start(self, name: str, module: str, params: dict) -> subprocess.Popen:
+        """Start one node; its output is shown unless quiet."""
+        out = subprocess.DEVNULL if self.quiet else None
+        proc = subprocess.Popen(
+            node_command(module, params),
+            env=self.env,
+            stdout=out,
+            stderr=out,
+            start_new_session=True,
+        )
+        self.procs[name] = proc
+        return proc
+
+    def stop(self, timeout: float = 5.0) -> None:
+        """SIGINT every node, then SIGKILL whatever is still running after ``timeout``."""
+        for proc in self.procs.values():
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGINT)
+        deadline = time.monotonic() + timeout
+        for proc in self.procs.values():
+            try:
+                proc.wait(max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+
+
+def main(argv=None) -> int:
+    """Run one episode through the graph; 0 if it ran (reached or not), 1 on errors."""
+    args = parse_args(argv)
+    try:
+        maze = load_named_maze(args.maze)
+        arb_path = args.arbitrator or str(default_arbitrator())
+        arb = ArbitratorFile.load(arb_path)
+    except (ConfigError, ArbitratorError) as e:
+        print(f"evorbc-sim: error: {e}", file=sys.stderr)
+        return 1
+    env = dict(os.environ)
+    env.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    if args.domain_id is not None:
+        env["ROS_DOMAIN_ID"] = str(args.domain_id)
+    env.setdefault("PYTHONUNBUFFERED", "1")
+    plot = args.plot or f"{maze.name}-run.png"
+    with tempfile.TemporaryDirectory() as tmp:
+        result_file = args.result or str(Path(tmp) / "result.json")
+        graph = Graph(env, args.quiet)
+        sim_time = {"use_sim_time": True}
+        graph.start("laser_sensor", NODES["laser_sensor"], {**sim_time, "sensor_layout": arb_path})
+        graph.start("radar_sensor", NODES["radar_sensor"], {**sim_time, "sensor_layout": arb_path})
+        graph.start(
+            "arbitrator",
+            NODES["arbitrator"],
+            {**sim_time, "arbitrator": arb_path, "repertoire": args.repertoire},
+        )
+        graph.start(
+            "primitive_executor", NODES["primitive_executor"], {**sim_time, "robot": arb.robot}
+        )
+        bridge = graph.start(
+            "sim_bridge",
+            "sim_bridge.bridge_node",
+            {
+                "maze": args.maze,
+                "robot": arb.robot,
+                "mode": args.mode,
+                "gui": args.gui,
+                "start": args.start,
+                "seed": args.seed,
+                "result_file": result_file,
+            },
+        )
+        if not args.quiet:
+            print(
+                f"evorbc-sim: {arb.kind} controller {arb_path} in maze {maze.name} "
+                f"({args.mode}), ROS_DOMAIN_ID={env.get('ROS_DOMAIN_ID', '0')}",
+                file=sys.stderr,
+            )
+        interrupted = False
+        try:
+            while bridge.poll() is None:
+                for name, proc in graph.procs.items():
+                    if name != "sim_bridge" and proc.poll() not in (None, 0):
+                        print(
+                            f"evorbc-sim: error: node {name} exited with status {proc.returncode}",
+                            file=sys.stderr,
+                        )
+                        graph.stop()
+                        return 1
+                time.sleep(0.05)
+        except KeyboardInterrupt:
+            interrupted = True
+            print("\nevorbc-sim: stopping the graph", file=sys.stderr)
+        finally:
+            graph.stop()
+        if not Path(result_file).exists():
+            print(
+                "evorbc-sim: error: the simulation bridge ended without a result "
+                f"(status {bridge.returncode})",
+                file=sys.stderr,
+            )
+            return 130 if interrupted else 1
+        result = json.loads(Path(result_file).read_text())
+    verdict = (
+        f"reached the target in {result['time']:.1f} s"
+        if result["reached"]
+        else f"did not reach the target, {result['final_distance']:.2f} m left"
+    )
+    print(f"{maze.name}: {verdict}, fitness {result['fitness']:.3f} ({args.mode}) -> {plot}")
+    from sim_bridge.maze_plot import plot_run
+
+    plot_run(
+        maze,
+        result["trajectory"],
+        f"{maze.name} via ROS 2 ({args.mode}): {verdict}, fitness {result['fitness']:.3f}",
+        plot,
+        episode_time=result["episode_time"],
+    )
+    return 130 if interrupted else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,163 @@
+"""The simulated world of the bridge: a 4WS robot in a maze, one control step at a time.
+
+The robot moves by the same compiled motion model as offline evolution
+(:func:`sim_bridge.four_ws_motion.step_robot`); wall contact and the laser's rays are
+computed by PyBullet (:class:`sim_bridge.pybullet_world.PyBulletMaze`). The contact rule is
+the offline one: if the footprint would overlap a wall after a step, the position stays
+and the heading change is kept.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from evorbc_ros.robots.four_ws import FourWSGeometry, robot_type
+from sim_bridge.four_ws_motion import (
+    ANGLE_FL,
+    HEADING,
+    SPEED,
+    STATE_SIZE,
+    X,
+    Y,
+    motion_limits,
+    step_robot,
+)
+from sim_bridge.maze import Maze
+from sim_bridge.pybullet_world import PyBulletMaze
+
+_NO_BOXES = np.empty((0, 6))
+_NO_CANDIDATES = np.empty(0, dtype=np.int64)
+
+
+@dataclass(frozen=True)
+class LaserConfig:
+    """The simulated scanner at the body centre: evenly spaced beams, REP 103 angles."""
+
+    beams: int = 360
+    angle_min: float = -math.pi  # rad, body frame
+    angle_max: float = math.pi  # rad; the last beam is one increment short of it
+    range_max: float = 2.0  # m
+    range_min: float = 0.0  # m
+
+    @property
+    def increment(self) -> float:
+        """Angle between beams (rad)."""
+        return (self.angle_max - self.angle_min) / self.beams
+
+    def angles(self) -> np.ndarray:
+        """Beam directions in the body frame (rad)."""
+        return self.angle_min + self.increment * np.arange(self.beams)
+
+
+@dataclass(frozen=True)
+class EpisodeStatus:
+    """Where an episode stands (eq. 5 fitness once it is over)."""
+
+    time: float  # s simulated
+    reached: bool
+    distance: float  # m, robot centre to target
+    initial_distance: float  # m
+    episode_time: float  # s, T of eq. 5
+
+    @property
+    def done(self) -> bool:
+        """Target reached or time up."""
+        return self.reached or self.time >= self.episode_time - 1e-9
+
+    @property
+    def fitness(self) -> float:
+        """Eq. 5: 2 - t/T if reached, else 1 - d_final / d_initial."""
+        if self.reached:
+            return 2.0 - self.time / self.episode_time
+        return 1.0 - self.distance / self.initial_distance if self.initial_distance > 0 else 0.0
+
+
+class SimWorld:
+    """A 4WS robot in a maze, stepped by wheel commands."""
+
+    def __init__(
+        self,
+        maze: Maze,
+        robot: str = "4ws-5",
+        start=None,
+        episode_time=120.0,
+        laser: LaserConfig = LaserConfig(),
+        gui: bool = False,
+        geometry: FourWSGeometry | None = None,
+    ) -> None:
+        self.maze = maze
+        self.type = robot_type(robot)
+        self.geometry = geometry or FourWSGeometry()
+        self.limits = motion_limits(self.geometry)
+        self.laser = laser
+        self.episode_time = episode_time
+        self.physics = PyBulletMaze(maze, self.geometry.footprint_radius, gui=gui)
+        self.state = np.zeros((1, STATE_SIZE))
+        self.state[0, :3] = maze.start_pose if start is None else start
+        self.time = 0.0
+        self.cycles = 0
+        self.wheel_angle = np.zeros(4)  # rad, integrated wheel rotation (joint states)
+        tx, ty = maze.target
+        self.initial_distance = math.hypot(self.state[0, X] - tx, self.state[0, Y] - ty)
+        self.reached = False
+        self.physics.show_pose(*self.pose)
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        """``(x m, y m, heading rad)`` in the maze frame (heading not wrapped)."""
+        return float(self.state[0, X]), float(self.state[0, Y]), float(self.state[0, HEADING])
+
+    @property
+    def steering(self) -> np.ndarray:
+        """(4,) current wheel angles (rad)."""
+        return self.state[0, ANGLE_FL : ANGLE_FL + 4].copy()
+
+    @property
+    def speed(self) -> float:
+        """Current wheel speed (m/s)."""
+        return float(self.state[0, SPEED])
+
+    def step(self, command: np.ndarray, wheel_radius: float = 0.02) -> float:
+        """Apply a ``(speed, fl, fr, rl, rr)`` command for one control period.
+
+        Returns:
+            Distance travelled (m); 0 if the wheels fought or a wall was in the way.
+        """
+        x0, y0 = self.state[0, X], self.state[0, Y]
+        moved = step_robot(
+            self.state,
+            0,
+            np.asarray(command, dtype=np.float64),
+            self.limits,
+            _NO_BOXES,
+            _NO_CANDIDATES,
+        )
+        if moved > 0.0 and not self.physics.footprint_clear(self.state[0, X], self.state[0, Y]):
+            self.state[0, X], self.state[0, Y] = x0, y0
+            moved = 0.0
+        self.wheel_angle += self.state[0, SPEED] * self.limits.dt / wheel_radius
+        self.cycles += 1
+        self.time = self.cycles * self.limits.dt
+        tx, ty = self.maze.target
+        if math.hypot(self.state[0, X] - tx, self.state[0, Y] - ty) <= self.maze.target_radius:
+            self.reached = True
+        self.physics.show_pose(*self.pose)
+        return moved
+
+    def scan(self) -> np.ndarray:
+        """Laser ranges (m, +inf for no return) at the current pose."""
+        x, y, h = self.pose
+        return self.physics.ranges(x, y, h + self.laser.angles(), self.laser.range_max)
+
+    def status(self) -> EpisodeStatus:
+        """Time, distance to the target and whether it was reached."""
+        tx, ty = self.maze.target
+        d = math.hypot(self.state[0, X] - tx, self.state[0, Y] - ty)
+        return EpisodeStatus(self.time, self.reached, d, self.initial_distance, self.episode_time)
+
+    def close(self) -> None:
+        """Release PyBullet."""
+        self.physics.close()
