@@ -146,7 +146,8 @@ def config_dir() -> Path:
     env = os.environ.get("EVORBC_CONFIG_DIR")
     if env:
         return Path(env)
-    source_tree = Path(__file__).resolve().parents[1] / "config"
-    if source_tree.is_dir():
-        return source_tree
+    root = Path(__file__).resolve().parents[1]
+    # A checkout or editable install: the project's own config/ beside its pyproject.toml.
+    if (root / "pyproject.toml").is_file() and (root / "config" / "sensors").is_dir():
+        return root / "config"
     return Path(sys.prefix) / "share" / "evorbc_ros" / "config"

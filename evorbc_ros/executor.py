@@ -72,8 +72,13 @@ class PrimitiveExecutor:
         self.last_seen[name] = now
 
     def stale(self, now: float) -> list[str]:
-        """Inputs older than the timeout (or never seen)."""
-        return [k for k, t in self.last_seen.items() if now - t > self.stale_timeout]
+        """Inputs older than the timeout (or never seen).
+
+        "Older" allows 1 us for rounding: clock stamps are integer nanoseconds and an age of
+        exactly the timeout must not count as stale.
+        """
+        limit = self.stale_timeout + 1e-6
+        return [k for k, t in self.last_seen.items() if now - t > limit]
 
     def command(self, now: float) -> WheelCommand:
         """The command to send at time ``now``."""

@@ -62,8 +62,8 @@ def stamp(seconds: float) -> Time:
 class SimBridgeNode(Node):
     """The simulated 4WS robot in a maze."""
 
-    def __init__(self) -> None:
-        super().__init__("sim_bridge")
+    def __init__(self, **kwargs) -> None:
+        super().__init__("sim_bridge", **kwargs)
         maze_name = declare(self, "maze", "obstacle", "maze name or maze YAML file")
         robot = declare(self, "robot", "4ws-5", "robot type")
         self.mode = declare(self, "mode", "lockstep", "lockstep or realtime")

@@ -5,6 +5,8 @@ import pytest
 from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
 
+pytest_plugins = ["ros_helpers"]  # the `ros` fixture for in-process ROS 2 tests
+
 
 def small_settings(**overrides):
     """A quick 4WS MAP-Elites run: Table I settings with a small budget."""

@@ -33,8 +33,8 @@ from evorbc_ros.repertoire import RepertoireError
 class ArbitratorNode(Node):
     """Chooses a primitive whenever a full set of new readings has arrived."""
 
-    def __init__(self) -> None:
-        super().__init__("arbitrator")
+    def __init__(self, **kwargs) -> None:
+        super().__init__("arbitrator", **kwargs)
         arbitrator = declare(
             self, "arbitrator", "", "arbitrator file (JSON); empty: the shipped 4ws-5 arbitrator"
         )

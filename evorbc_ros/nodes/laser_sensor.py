@@ -29,8 +29,8 @@ from evorbc_ros.nodes.common import (
 class LaserSensorNode(Node):
     """Converts each scan into rangefinder readings."""
 
-    def __init__(self) -> None:
-        super().__init__("laser_sensor")
+    def __init__(self, **kwargs) -> None:
+        super().__init__("laser_sensor", **kwargs)
         layout = load_sensor_layout(
             declare(
                 self,

@@ -36,8 +36,8 @@ from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES, FourWSGeometry
 class PrimitiveExecutorNode(Node):
     """Publishes wheel commands at 10 Hz and stops the robot when inputs go stale."""
 
-    def __init__(self) -> None:
-        super().__init__("primitive_executor")
+    def __init__(self, **kwargs) -> None:
+        super().__init__("primitive_executor", **kwargs)
         robot = declare(self, "robot", "4ws-5", "robot type: 2ws-2, 2ws-3, 4ws-3 or 4ws-5")
         if robot not in ROBOT_TYPES:
             raise StartupError(
@@ -82,10 +82,7 @@ class PrimitiveExecutorNode(Node):
         ]
         self.subs += [
             self.create_subscription(
-                Float64MultiArray,
-                t,
-                lambda msg, t=t: self.logic.on_input(t, now_seconds(self)),
-                RELIABLE,
+                Float64MultiArray, t, lambda msg, t=t: self.on_input(t), RELIABLE
             )
             for t in inputs
         ]
@@ -104,6 +101,15 @@ class PrimitiveExecutorNode(Node):
             )
             return
         self.publish(self.logic.command(now), now)
+
+    def on_input(self, topic: str) -> None:
+        """Note a sensor input; if the robot was stopped for it, run again at once."""
+        now = now_seconds(self)
+        self.logic.on_input(topic, now)
+        if self.stopped_reason:
+            command = self.logic.command(now)
+            if not command.stopped:
+                self.publish(command, now)
 
     def on_timer(self) -> None:
         """Stop on stale inputs; otherwise keep commands flowing at least every period."""

@@ -33,8 +33,8 @@ from evorbc_ros.nodes.common import (
 class RadarSensorNode(Node):
     """Publishes goal-direction readings for every pose."""
 
-    def __init__(self) -> None:
-        super().__init__("radar_sensor")
+    def __init__(self, **kwargs) -> None:
+        super().__init__("radar_sensor", **kwargs)
         layout = load_sensor_layout(
             declare(
                 self,
