@@ -9,7 +9,6 @@ back. Times are seconds on the node's clock (simulated or wall).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,7 +44,8 @@ class PrimitiveExecutor:
         self.robot = robot
         self.geometry = geometry
         self.stale_timeout = stale_timeout
-        self.last_seen = {name: -math.inf for name in ["primitive", *inputs]}
+        self.last_seen: dict[str, float | None] = dict.fromkeys(["primitive", *inputs])
+        self.first_event: float | None = None  # when the first input of any kind arrived
         self.genes: np.ndarray | None = None
         self.steering = np.zeros(4)  # last commanded angles, held while stopped
 
@@ -65,20 +65,29 @@ class PrimitiveExecutor:
         if not np.all(np.isfinite(g)) or np.any(np.abs(g) > 1.0 + 1e-9):
             raise InputError(f"primitive genes must be finite and in [-1, 1], got {g.tolist()}")
         self.genes = g
-        self.last_seen["primitive"] = now
+        self.on_input("primitive", now)
 
     def on_input(self, name: str, now: float) -> None:
         """A sensor input arrived (only its time matters here)."""
+        if self.first_event is None:
+            self.first_event = now
         self.last_seen[name] = now
 
     def stale(self, now: float) -> list[str]:
-        """Inputs older than the timeout (or never seen).
+        """Inputs older than the timeout.
 
-        "Older" allows 1 us for rounding: clock stamps are integer nanoseconds and an age of
-        exactly the timeout must not count as stale.
+        An input that has not arrived yet only counts once the timeout has passed since the
+        first input of any kind: at start-up the streams arrive in any order. "Older" allows
+        1 us for rounding: clock stamps are integer nanoseconds and an age of exactly the
+        timeout must not count as stale.
         """
         limit = self.stale_timeout + 1e-6
-        return [k for k, t in self.last_seen.items() if now - t > limit]
+        out = []
+        for name, t in self.last_seen.items():
+            since = t if t is not None else self.first_event
+            if since is not None and now - since > limit:
+                out.append(name)
+        return out
 
     def command(self, now: float) -> WheelCommand:
         """The command to send at time ``now``."""

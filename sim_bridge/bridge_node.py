@@ -83,9 +83,28 @@ class SimBridgeNode(Node):
         self.lockstep_timeout = finite_parameter(
             self,
             "lockstep_timeout",
-            0.5,
+            2.0,
             "wall seconds before the state is sent again",
             positive=True,
+        )
+        self.wait_subscribers = declare(
+            self,
+            "wait_for_subscribers",
+            ["scan", "odom"],
+            "topics that need a subscriber before the run starts",
+        )
+        self.wait_publishers = declare(
+            self,
+            "wait_for_publishers",
+            [
+                "steering_position_controller/commands",
+                "wheel_velocity_controller/commands",
+                "evorbc/primitive",
+            ],
+            "topics that need a publisher before the run starts",
+        )
+        self.startup_timeout = finite_parameter(
+            self, "startup_timeout", 30.0, "wall seconds to wait for the graph", positive=True
         )
         self.result_file = declare(self, "result_file", "", "write the result here (JSON)")
         self.progress_period = finite_parameter(
@@ -229,11 +248,35 @@ class SimBridgeNode(Node):
 
     # -- running -----------------------------------------------------------------------
 
+    def wait_for_graph(self, executor) -> None:
+        """Wait until the controller's nodes are connected, so no first message is lost.
+
+        In lockstep a lost first state would have to be sent again, and nodes that had
+        already seen it would then answer twice.
+        """
+        deadline = time.monotonic() + self.startup_timeout
+
+        def missing() -> list[str]:
+            out = [t for t in self.wait_subscribers if self.count_subscribers(t) == 0]
+            return out + [t for t in self.wait_publishers if self.count_publishers(t) == 0]
+
+        while missing() and time.monotonic() < deadline and rclpy.ok():
+            executor.spin_once(timeout_sec=0.05)
+        if missing():
+            self.get_logger().warning(f"starting without {', '.join(missing())}")
+            return
+        # Both ends of a new DDS connection match at about the same time; give the far
+        # end a moment before the first reliable message.
+        settle = time.monotonic() + 0.3
+        while time.monotonic() < settle:
+            executor.spin_once(timeout_sec=0.05)
+
     def run_lockstep(self) -> None:
         """The lockstep loop: state out, both commands in, step."""
         executor = rclpy.executors.SingleThreadedExecutor()
         executor.add_node(self)
         try:
+            self.wait_for_graph(executor)
             while not self.world.status().done and rclpy.ok():
                 self.fresh = {"steering": False, "wheel": False}
                 self.publish_state()
@@ -259,6 +302,7 @@ class SimBridgeNode(Node):
         executor.add_node(self)
         period = self.world.limits.dt
         try:
+            self.wait_for_graph(executor)
             self.publish_state()
             next_tick = time.monotonic() + period
             while not self.world.status().done and rclpy.ok():

@@ -68,9 +68,11 @@ def parse_args(argv=None) -> argparse.Namespace:
 
 
 def node_command(module: str, params: dict) -> list[str]:
-    """``python -m module --ros-args -p k:=v ...``."""
+    """``python -m module --ros-args -p k:=v ...`` (empty values are left out)."""
     cmd = [sys.executable, "-m", module, "--ros-args"]
     for key, value in params.items():
+        if value == "":
+            continue  # rcl cannot parse an empty override; every empty default means "none"
         text = str(value).lower() if isinstance(value, bool) else str(value)
         cmd += ["-p", f"{key}:={text}"]
     return cmd

@@ -12,6 +12,7 @@ Each world has its own PyBullet client, so several can live in one process.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -24,20 +25,47 @@ from sim_bridge.maze import Maze
 WALL_GROUP, ROBOT_GROUP = 1, 2
 
 
+#: Width (m) of the narrowest strip at each vertical edge of the wall mesh. Bullet accepts
+#: a ray hit slightly outside a triangle, by a margin proportional to the triangle's size
+#: (about 1e-5 of it here). Strips that double in width away from each edge keep every
+#: triangle's margin inside the face, so a ray that passes a wall's end or corner misses it,
+#: as it does for the offline boxes, unless it passes within about 1e-13 m.
+EDGE_STRIP = 1e-9
+
+
+def _cuts(width: float) -> list[float]:
+    """Positions (fractions of ``width``) of strips doubling in width from both edges."""
+    half, edges, w = 0.5 * width, [], EDGE_STRIP
+    while sum(edges) + w < half:
+        edges.append(w)
+        w *= 2.0
+    near = np.cumsum([0.0, *edges]) / width
+    return sorted({*near.tolist(), 0.5, *(1.0 - near).tolist()})
+
+
+def _face(a, b, height: float, vertices: list, indices: list) -> None:
+    """A vertical wall face from corner ``a`` to ``b`` (xy), in strips (see EDGE_STRIP)."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    cuts = _cuts(float(np.hypot(*(b - a))))
+    for t0, t1 in itertools.pairwise(cuts):
+        p0, p1 = a + t0 * (b - a), a + t1 * (b - a)
+        base = len(vertices)
+        vertices += [[*p0, 0.0], [*p1, 0.0], [*p1, height], [*p0, height]]
+        indices += [base, base + 1, base + 2, base, base + 2, base + 3]
+
+
 def _wall_mesh(boxes: np.ndarray, height: float) -> tuple[list, list]:
-    """Vertices and triangle indices of the boxes extruded from z = 0 to ``height``."""
-    vertices, indices = [], []
+    """Vertices and triangle indices of the boxes extruded from z = 0 to ``height``.
+
+    Only the vertical faces: rays and the footprint stay at mid-height, far from the top
+    and bottom.
+    """
+    vertices: list = []
+    indices: list = []
     ring = (0, 1, 3, 2)  # corners of box_corners in order around the box
     for corners in box_corners(boxes):
-        base = len(vertices)
-        vertices += [[x, y, z] for z in (0.0, height) for x, y in corners]
         for k in range(4):
-            a, b = base + ring[k], base + ring[(k + 1) % 4]
-            indices += [a, b, b + 4, a, b + 4, a + 4]  # side faces
-        bottom = [base + r for r in ring]
-        top = [v + 4 for v in bottom]
-        indices += [top[0], top[1], top[2], top[0], top[2], top[3]]
-        indices += [bottom[0], bottom[2], bottom[1], bottom[0], bottom[3], bottom[2]]
+            _face(corners[ring[k]], corners[ring[(k + 1) % 4]], height, vertices, indices)
     return vertices, indices
 
 

@@ -160,7 +160,9 @@ def test_executor_stops_within_a_cycle_of_stale_input_and_resumes(ros):
         seen = node.logic.last_seen
         topics = ["primitive", "evorbc/goal_sectors"]
         topics += ["evorbc/rangefinders"] if with_rangefinders else []
-        assert ros.spin_until(lambda: all(abs(seen[k] - t) < 1e-6 for k in topics))
+        assert ros.spin_until(
+            lambda: all(seen[k] is not None and abs(seen[k] - t) < 1e-6 for k in topics)
+        )
         ros.spin_until(lambda: False, timeout=0.02)  # let any reply go out
 
     t = 1.0

@@ -3,13 +3,15 @@
 Subscribes ``evorbc/rangefinders`` and ``evorbc/goal_sectors`` (Float64MultiArray); once
 both have a new message it publishes the chosen primitive's genes on ``evorbc/primitive``
 (Float64MultiArray, labelled with the parameter names) and, for EvoRBC, the diagnostic
-``evorbc/mapping`` = ``[m1, m2, x, y, primitive index]``. By default it runs the arbitrator
+``evorbc/mapping`` = ``[m1, m2, x, y, primitive index]``, also appended to ``record_file``
+(JSON lines) if set. By default it runs the arbitrator
 and repertoire shipped with the package, so ``ros2 run evorbc_ros arbitrator`` needs no
 arguments. Bad files or a repertoire/sensor mismatch stop it at start-up with one line.
 """
 
 from __future__ import annotations
 
+import json
 import sys
 
 from rclpy.node import Node
@@ -19,6 +21,7 @@ from evorbc_ros.arbitration import Controller, InputGroups
 from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.laser import InputError
 from evorbc_ros.nodes.common import (
+    DIAGNOSTICS,
     RELIABLE,
     StartupError,
     declare,
@@ -85,12 +88,24 @@ class ArbitratorNode(Node):
             "evorbc/mapping",
             "diagnostics [m1, m2, x, y, primitive] (Float64MultiArray)",
         )
+        record = declare(
+            self,
+            "record_file",
+            "",
+            "append every choice here as JSON lines (m1, m2, x, y, primitive)",
+        )
+        try:
+            self.record = open(record, "a", buffering=1) if record else None  # noqa: SIM115
+        except OSError as e:
+            raise StartupError(
+                f"parameter record_file: cannot open {record} ({e.strerror})"
+            ) from None
         layout = spec.sensors
         n_rf = len(layout.rangefinders.angles) if layout.rangefinders else 0
         sizes = {rf_topic: n_rf, goal_topic: layout.n_inputs - n_rf}
         self.groups = InputGroups({k: v for k, v in sizes.items() if v > 0})
         self.pub = self.create_publisher(Float64MultiArray, out_topic, RELIABLE)
-        self.map_pub = self.create_publisher(Float64MultiArray, map_topic, RELIABLE)
+        self.map_pub = self.create_publisher(Float64MultiArray, map_topic, DIAGNOSTICS)
         self.subs = [
             self.create_subscription(
                 Float64MultiArray, topic, lambda msg, t=topic: self.on_input(t, msg), RELIABLE
@@ -120,6 +135,15 @@ class ArbitratorNode(Node):
         self.pub.publish(vector_message(genes, self.controller.parameter_names))
         if diagnostics:
             self.map_pub.publish(vector_message(diagnostics, ["m1", "m2", "x", "y", "primitive"]))
+        if self.record is not None:
+            self.record.write(json.dumps(diagnostics or list(map(float, genes))) + "\n")
+
+    def destroy_node(self) -> None:
+        """Close the record file, then the node."""
+        if self.record is not None:
+            self.record.close()
+            self.record = None
+        super().destroy_node()
 
 
 def main(argv=None) -> int:

@@ -27,6 +27,11 @@ from std_msgs.msg import Float64MultiArray, MultiArrayDimension
 RELIABLE = QoSProfile(
     depth=10, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST
 )
+#: Diagnostics that tools record: a deep history, so a listener that falls behind for a
+#: moment (a plotting tool, a test) does not lose samples.
+DIAGNOSTICS = QoSProfile(
+    depth=200, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST
+)
 #: Latched topics (the goal): late joiners get the last message.
 LATCHED = QoSProfile(
     depth=1,
@@ -74,7 +79,12 @@ def now_seconds(node: Node) -> float:
 
 def run_node(make: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
     """Init / construct / spin / destroy / try_shutdown, with one-line start-up errors."""
-    rclpy.init(args=argv)
+    try:
+        rclpy.init(args=argv)
+    except Exception as e:  # rcl reports bad --ros-args as a generic RCLError
+        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        print(f"error: cannot start: {first}", file=sys.stderr)
+        return 2
     node = None
     try:
         node = make()

@@ -1,0 +1,170 @@
+"""The ROS 2 graph across processes (localhost discovery): lockstep parity with the offline
+replay, real-time mode, and a node restarted in the middle of a run."""
+
+import json
+import os
+import signal
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+from evorbc_ros.arbitrator import ArbitratorFile
+from evorbc_ros.defaults import default_arbitrator, default_repertoire
+from evorbc_ros.repertoire import Repertoire
+from offline_evolution.maze_task.replay import replay
+from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
+from sim_bridge.bringup import NODES, node_command
+
+MAZES = ["obstacle", "zigzag", "baffles", "corridors", "gaps"]
+
+
+def graph_env(domain: int) -> dict:
+    env = dict(
+        os.environ,
+        ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+        PYTHONUNBUFFERED="1",
+        ROS_DOMAIN_ID=str(domain),
+    )
+    return env
+
+
+class GraphRun:
+    """The five processes of the simulated graph; the arbitrator records its choices."""
+
+    def __init__(self, tmp_path, domain, maze, mode="lockstep", episode_time=120.0):
+        self.env = graph_env(domain)
+        self.result = tmp_path / f"{maze}-{mode}.json"
+        self.log = open(tmp_path / f"{maze}-{mode}.log", "w")  # noqa: SIM115
+        self.arb = str(default_arbitrator())
+        self.choices = tmp_path / f"{maze}-{mode}.choices.jsonl"
+        self.procs = {}
+        for name, module in NODES.items():
+            params = {"use_sim_time": True}
+            if name in ("laser_sensor", "radar_sensor"):
+                params["sensor_layout"] = self.arb
+            if name == "arbitrator":
+                params["record_file"] = str(self.choices)
+            self.start(name, module, params)
+        self.bridge = self.start(
+            "sim_bridge",
+            "sim_bridge.bridge_node",
+            {
+                "maze": maze,
+                "mode": mode,
+                "result_file": str(self.result),
+                "episode_time": episode_time,
+            },
+        )
+
+    def start(self, name, module, params):
+        proc = subprocess.Popen(
+            node_command(module, params),
+            env=self.env,
+            stdout=self.log,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )
+        self.procs[name] = proc
+        return proc
+
+    def wait(self, timeout):
+        self.bridge.wait(timeout)
+        return json.loads(self.result.read_text())
+
+    def recorded_choices(self):
+        """The primitive the arbitrator chose at each cycle (its record file)."""
+        rows = [json.loads(line) for line in self.choices.read_text().splitlines()]
+        return np.array([int(r[4]) for r in rows])
+
+    def stop(self):
+        for p in self.procs.values():
+            if p.poll() is None:
+                p.send_signal(signal.SIGINT)
+        for p in self.procs.values():
+            try:
+                p.wait(5)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+        self.log.close()
+
+
+@pytest.fixture(scope="module")
+def offline():
+    """The shipped arbitrator replayed offline from each maze's nominal start."""
+    arb = ArbitratorFile.load(default_arbitrator())
+    repertoire = Repertoire.load(default_repertoire(arb.robot))
+    task = MazeTask(MazeTaskSettings(tuple(MAZES), 120.0), arb.robot)
+    outcomes, result = replay(arb, task, task.nominal_starts(), repertoire)
+    return outcomes, result
+
+
+@pytest.mark.parametrize("k", range(len(MAZES)), ids=MAZES)
+def test_lockstep_graph_makes_the_offline_choices_and_reaches_the_target(tmp_path, offline, k):
+    outcomes, result = offline
+    run = GraphRun(tmp_path, 150 + k, MAZES[k])
+    try:
+        got = run.wait(timeout=120)
+    finally:
+        run.stop()
+    cycles = int(result.cycles[k])
+    want = result.choice[k, :cycles]
+    choices = run.recorded_choices()
+    # The same primitive at every cycle; the bridge's final state may draw one more choice,
+    # which is never applied.
+    assert len(choices) in (cycles, cycles + 1)
+    np.testing.assert_array_equal(choices[:cycles], want)
+    trajectory = np.array(got["trajectory"])
+    np.testing.assert_allclose(trajectory, result.pose[k, : cycles + 1], atol=1e-9)
+    assert got["time"] == pytest.approx(outcomes[k].time, abs=1e-9)
+    assert got["fitness"] == pytest.approx(outcomes[k].fitness, abs=1e-12)
+    assert got["reached"] and outcomes[k].reached
+
+
+def test_realtime_mode_runs_at_ten_hertz(tmp_path):
+    run = GraphRun(tmp_path, 160, "zigzag", mode="realtime", episode_time=3.0)
+    start = time.monotonic()
+    try:
+        got = run.wait(timeout=60)
+    finally:
+        run.stop()
+    wall = time.monotonic() - start
+    assert got["mode"] == "realtime" and got["time"] == pytest.approx(3.0)
+    assert len(got["trajectory"]) == 31
+    assert wall >= 3.0  # simulated time did not outrun the wall clock
+    moved = np.hypot(*np.diff(np.array(got["trajectory"])[:, :2], axis=0).T).sum()
+    assert moved > 0.2  # the controller drove the robot
+
+
+def test_a_restarted_arbitrator_rejoins_and_the_run_continues(tmp_path):
+    run = GraphRun(tmp_path, 161, "gaps")
+    try:
+        deadline = time.monotonic() + 60
+        log = tmp_path / "gaps-lockstep.log"
+        while "t =  10.0 s" not in log.read_text() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert "t =  10.0 s" in log.read_text()
+        arb = run.procs["arbitrator"]
+        arb.send_signal(signal.SIGINT)
+        arb.wait(10)
+        run.start("arbitrator", NODES["arbitrator"], {"use_sim_time": True})
+        got = run.wait(timeout=120)
+    finally:
+        run.stop()
+    assert got["time"] > 10.0
+    assert got["reached"]
+    assert "sending the state again" in log.read_text()
+
+
+def test_nodes_refuse_bad_parameters_with_one_line(tmp_path):
+    cmd = node_command(NODES["arbitrator"], {"arbitrator": str(tmp_path / "missing.json")})
+    done = subprocess.run(cmd, env=graph_env(162), capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines()[-1] == (
+        f"error: {tmp_path / 'missing.json'}: no such arbitrator file"
+    )
+    cmd = node_command("sim_bridge.bridge_node", {"maze": "labyrinth"})
+    done = subprocess.run(cmd, env=graph_env(163), capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2 and "unknown maze 'labyrinth'" in done.stderr
