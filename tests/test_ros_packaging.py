@@ -1,0 +1,170 @@
+"""Installed with pip, the package registers itself in the ament index (DESIGN.md section 10).
+
+``ros2 run evorbc_ros <node>`` looks up ``share/ament_index/resource_index/packages/
+evorbc_ros`` under ``AMENT_PREFIX_PATH`` and runs ``<prefix>/lib/evorbc_ros/<node>``. This
+builds the wheel, installs it into a fresh prefix and checks both the index and the
+executables, without the ros2 CLI; with it, ``ros2 run`` itself is tried too.
+"""
+
+import os
+import py_compile
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+EVORBC_NODES = ["laser_sensor", "radar_sensor", "arbitrator", "primitive_executor"]
+
+
+@pytest.fixture(scope="module")
+def prefix(tmp_path_factory):
+    """The project installed (no dependencies) into an empty prefix."""
+    out = tmp_path_factory.mktemp("prefix")
+    wheels = tmp_path_factory.mktemp("wheel")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", str(ROOT), "-w", str(wheels)],
+        check=True,
+        timeout=300,
+        capture_output=True,
+    )
+    wheel = next(wheels.glob("evorbc-*.whl"))
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "install",
+            "-q",
+            "--no-deps",
+            "--prefix",
+            str(out),
+            str(wheel),
+        ],
+        check=True,
+        timeout=300,
+        capture_output=True,
+    )
+    return out
+
+
+def site_packages(prefix: Path) -> Path:
+    return next(prefix.glob("lib/python3*/site-packages"))
+
+
+def installed_env(prefix: Path) -> dict:
+    """The installed copy first on the path, the test venv's interpreter as python3."""
+    return dict(
+        os.environ,
+        AMENT_PREFIX_PATH=str(prefix),
+        PYTHONPATH=str(site_packages(prefix)),
+        PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}",
+        ROS_AUTOMATIC_DISCOVERY_RANGE="OFF",
+    )
+
+
+def test_the_ament_index_finds_both_packages(prefix, tmp_path):
+    script = (
+        "from ament_index_python.packages import get_package_prefix, "
+        "get_package_share_directory as share\n"
+        "print(get_package_prefix('evorbc_ros')); print(share('evorbc_ros')); "
+        "print(share('sim_bridge'))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script],
+        env=installed_env(prefix),
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+        cwd=tmp_path,
+    ).stdout.split()
+    assert out == [
+        str(prefix),
+        str(prefix / "share" / "evorbc_ros"),
+        str(prefix / "share" / "sim_bridge"),
+    ]
+    share = prefix / "share" / "evorbc_ros"
+    assert (share / "package.xml").read_text().count("<name>evorbc_ros</name>") == 1
+    assert (share / "launch" / "sim.launch.py").exists()
+    for rel in (
+        "config/ros/evorbc_nodes.yaml",
+        "config/sensors/4ws.yaml",
+        "config/mazes/obstacle.yaml",
+        "config/neat/4ws.ini",
+    ):
+        assert (share / rel).exists(), rel
+
+
+@pytest.mark.parametrize("node", EVORBC_NODES)
+def test_every_node_is_an_executable_in_lib(prefix, node):
+    exe = prefix / "lib" / "evorbc_ros" / node
+    assert exe.is_file() and os.access(exe, os.X_OK)
+
+
+def test_an_installed_node_starts_and_reports_bad_files(prefix, tmp_path):
+    exe = prefix / "lib" / "evorbc_ros" / "arbitrator"
+    missing = tmp_path / "missing.json"
+    done = subprocess.run(
+        [str(exe), "--ros-args", "-p", f"arbitrator:={missing}"],
+        env=installed_env(prefix),
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
+    )
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.strip().splitlines()[-1] == f"error: {missing}: no such arbitrator file"
+    # It ran the installed copy, whose settings come from the prefix's share folder.
+    script = "from evorbc_ros.config import config_dir; print(config_dir())"
+    where = subprocess.run(
+        [sys.executable, "-c", script],
+        env=installed_env(prefix),
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+        cwd=tmp_path,
+    ).stdout
+    assert where.strip() == str(prefix / "share" / "evorbc_ros" / "config")
+
+
+def test_sim_bridge_is_registered_too(prefix):
+    exe = prefix / "lib" / "sim_bridge" / "sim_bridge"
+    assert exe.is_file() and os.access(exe, os.X_OK)
+
+
+def test_the_launch_file_is_valid_python():
+    py_compile.compile(str(ROOT / "launch" / "sim.launch.py"), doraise=True)
+
+
+@pytest.mark.skipif(shutil.which("ros2") is None, reason="needs the ros2 CLI (full ROS 2)")
+def test_ros2_run_finds_the_arbitrator(prefix, tmp_path):
+    missing = tmp_path / "missing.json"
+    done = subprocess.run(
+        ["ros2", "run", "evorbc_ros", "arbitrator", "--ros-args", "-p", f"arbitrator:={missing}"],
+        env=installed_env(prefix),
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert "no such arbitrator file" in done.stderr
+
+
+@pytest.mark.skipif(shutil.which("ros2") is None, reason="needs the ros2 CLI (full ROS 2)")
+def test_the_launch_file_builds_a_description(prefix):
+    script = (
+        "import runpy; d = runpy.run_path('launch/sim.launch.py')"
+        "['generate_launch_description'](); print(len(d.entities))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script],
+        cwd=ROOT,
+        env=installed_env(prefix),
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0 and int(done.stdout) == 10
