@@ -125,6 +125,8 @@ class SimBridgeNode(Node):
         self.trajectory = [list(self.world.pose)]
         self.commands = {"steering": None, "wheel": None}
         self.fresh = {"steering": False, "wheel": False}
+        self.command_times: list[float] = []  # wall-clock arrivals of wheel commands (s)
+        self.loop_start = None  # wall clock when the episode started (after the graph)
 
         self.clock_pub = self.create_publisher(Clock, "/clock", RELIABLE)
         self.scan_pub = self.create_publisher(LaserScan, "scan", RELIABLE)
@@ -190,6 +192,8 @@ class SimBridgeNode(Node):
             return
         self.commands[which] = values
         self.fresh[which] = True
+        if which == "wheel":
+            self.command_times.append(time.monotonic())
 
     def wheel_command(self) -> np.ndarray:
         """``(speed m/s, fl, fr, rl, rr rad)`` from the latest commands (stopped if none)."""
@@ -277,6 +281,7 @@ class SimBridgeNode(Node):
         executor.add_node(self)
         try:
             self.wait_for_graph(executor)
+            self.loop_start = time.monotonic()
             while not self.world.status().done and rclpy.ok():
                 self.fresh = {"steering": False, "wheel": False}
                 self.publish_state()
@@ -303,6 +308,7 @@ class SimBridgeNode(Node):
         period = self.world.limits.dt
         try:
             self.wait_for_graph(executor)
+            self.loop_start = time.monotonic()
             self.publish_state()
             next_tick = time.monotonic() + period
             while not self.world.status().done and rclpy.ok():
@@ -328,6 +334,10 @@ class SimBridgeNode(Node):
             "episode_time": s.episode_time,
             "mode": self.mode,
             "trajectory": self.trajectory,
+            "command_times": self.command_times,
+            "wall_seconds": None
+            if self.loop_start is None
+            else (time.monotonic() - self.loop_start),
         }
         verdict = (
             f"reached the target in {s.time:.1f} s"

@@ -39,6 +39,7 @@ def prefix(tmp_path_factory):
             "install",
             "-q",
             "--no-deps",
+            "--ignore-installed",  # never touch the test environment's own install
             "--prefix",
             str(out),
             str(wheel),
