@@ -7,18 +7,32 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.evorbc-installed
 OUT    ?= demo-output
 
-.PHONY: demo test lint bench clean
+.PHONY: demo demo-repertoire demo-evolve test lint bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[dev]"
 	touch $(STAMP)
 
+# The main job: the shipped 4ws-5 controller driving the simulated robot through a maze,
+# as five ROS 2 nodes in separate processes over DDS (lockstep), with a trajectory picture.
 demo: $(STAMP)
+	$(VENV)/bin/evorbc-sim --maze obstacle --plot $(OUT)/obstacle-run.png \
+		--result $(OUT)/obstacle-run.json
+	@echo "demo: open $(OUT)/obstacle-run.png; try another maze with: $(VENV)/bin/evorbc-sim --maze gaps"
+
+# A MAP-Elites repertoire for the 4ws-5 robot at the paper's full budget (about 5 s).
+demo-repertoire: $(STAMP)
 	$(VENV)/bin/evorbc-evolve repertoire --robot 4ws-5 --seed 1 \
 		--out $(OUT)/4ws-5.repertoire.json --plot $(OUT)/4ws-5.repertoire.png \
 		--csv $(OUT)/4ws-5.repertoire.csv
-	@echo "demo: open $(OUT)/4ws-5.repertoire.png to see the repertoire"
+
+# A whole EvoRBC run: repertoire, then 1000 generations of NEAT (about 6 min on 2 cores).
+demo-evolve: demo-repertoire
+	$(VENV)/bin/evorbc-evolve arbitrator --repertoire $(OUT)/4ws-5.repertoire.json --seed 1 \
+		--out $(OUT)/4ws-5.arbitrator.json
+	$(VENV)/bin/evorbc-evolve replay --arbitrator $(OUT)/4ws-5.arbitrator.json \
+		--plot $(OUT)/4ws-5.replay.png --heatmap $(OUT)/4ws-5.selection.png
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
@@ -29,6 +43,8 @@ test: lint
 
 bench: $(STAMP)
 	$(PY) bench/bench_repertoire.py
+	$(PY) bench/bench_arbitrator.py
+	$(PY) bench/bench_ros.py
 
 clean:
 	rm -rf $(VENV) $(OUT) build *.egg-info

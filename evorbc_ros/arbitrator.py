@@ -25,12 +25,12 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.json_files import load_json_file
 from evorbc_ros.mapping import MAPPINGS, MappingFunction, PrimitiveLookup
 from evorbc_ros.network import NetworkError, NetworkSpec
 from evorbc_ros.repertoire import Repertoire
@@ -92,22 +92,8 @@ class ArbitratorFile:
         Raises:
             ArbitratorError: one line naming the file and the problem.
         """
-        source = str(path)
-        try:
-            text = Path(path).read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise ArbitratorError(f"{source}: no such arbitrator file") from None
-        except (OSError, UnicodeDecodeError) as e:
-            raise ArbitratorError(f"{source}: cannot read ({e})") from None
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as e:
-            what = "truncated" if e.pos >= len(text.rstrip()) else "corrupt"
-            raise ArbitratorError(
-                f"{source}: {what} arbitrator file (invalid JSON at line "
-                f"{e.lineno}, column {e.colno}: {e.msg})"
-            ) from None
-        return cls.from_dict(data, source)
+        data = load_json_file(path, "arbitrator", ArbitratorError)
+        return cls.from_dict(data, str(path))
 
     @classmethod
     def from_dict(cls, data: Any, source: str = "arbitrator") -> ArbitratorFile:

@@ -29,12 +29,12 @@ import json
 import math
 import os
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.json_files import load_json_file
 from evorbc_ros.robots.primitive import GENE_HIGH, GENE_LOW, ParameterSpec
 
 FORMAT = "evorbc-repertoire"
@@ -243,24 +243,8 @@ class Repertoire:
                 truncated, not JSON, wrong format or version, inconsistent shapes, ...).
 
         """
-        source = str(path)
-        try:
-            text = Path(path).read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise RepertoireError(f"{source}: no such repertoire file") from None
-        except UnicodeDecodeError:
-            raise RepertoireError(f"{source}: not a repertoire file (not UTF-8 text)") from None
-        except OSError as e:
-            raise RepertoireError(f"{source}: cannot read ({e.strerror})") from None
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as e:
-            what = "truncated" if e.pos >= len(text.rstrip()) else "corrupt"
-            raise RepertoireError(
-                f"{source}: {what} repertoire file (invalid JSON at line {e.lineno}, "
-                f"column {e.colno}: {e.msg})"
-            ) from None
-        return cls.from_dict(data, source)
+        data = load_json_file(path, "repertoire", RepertoireError)
+        return cls.from_dict(data, str(path))
 
 
 def _require(data: dict, key: str, kind, source: str, prefix: str = ""):

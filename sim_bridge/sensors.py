@@ -8,6 +8,7 @@ the maze's wall boxes (see :mod:`sim_bridge.geometry`).
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numba as nb
 import numpy as np
@@ -22,8 +23,8 @@ tiling_sector = nb.njit(cache=True)(onboard.tiling_sector)
 goal_bearing_reading = nb.njit(cache=True)(onboard.goal_bearing_reading)
 
 
-class CompiledLayout:
-    """A :class:`SensorLayout` as arrays for the compiled kernels.
+class CompiledLayout(NamedTuple):
+    """A :class:`SensorLayout` as arrays for the compiled kernels (see :func:`compile_layout`).
 
     Attributes:
         ray_angles: ``(n_rangefinders, rays)`` ray directions in the body frame, rad.
@@ -31,71 +32,71 @@ class CompiledLayout:
         sector_centres: ``(n_sectors,)`` rad; ``sector_width`` rad; ``sector_tiles`` 1 if
             the sectors tile the circle (one index per bearing), else 0.
         goal_bearing: 1 if the layout ends with a goal-bearing input, else 0.
+        n_inputs: number of arbitrator inputs.
     """
 
-    def __init__(self, layout: SensorLayout) -> None:
-        rf = layout.rangefinders
-        self.ray_angles = (rf.ray_angles() if rf else np.zeros((0, 1))).astype(np.float64)
-        self.max_range = float(rf.max_range) if rf else 1.0
-        self.mount_radius = float(rf.mount_radius) if rf else 0.0
-        gs = layout.goal_sectors
-        self.sector_centres = np.array(gs.centres if gs else (), dtype=np.float64)
-        self.sector_width = float(gs.width) if gs else 0.0
-        self.sector_tiles = int(bool(gs and gs.tiles))
-        self.goal_bearing = int(layout.goal_bearing)
-        self.n_inputs = layout.n_inputs
+    ray_angles: np.ndarray
+    max_range: float
+    mount_radius: float
+    sector_centres: np.ndarray
+    sector_width: float
+    sector_tiles: int
+    goal_bearing: int
+    n_inputs: int
 
     def reach(self) -> float:
         """How far from the body centre a ray can see (m)."""
         return self.mount_radius + self.max_range
 
 
+def compile_layout(layout: SensorLayout) -> CompiledLayout:
+    """The arrays of ``layout``."""
+    rf = layout.rangefinders
+    gs = layout.goal_sectors
+    return CompiledLayout(
+        ray_angles=(rf.ray_angles() if rf else np.zeros((0, 1))).astype(np.float64),
+        max_range=float(rf.max_range) if rf else 1.0,
+        mount_radius=float(rf.mount_radius) if rf else 0.0,
+        sector_centres=np.array(gs.centres if gs else (), dtype=np.float64),
+        sector_width=float(gs.width) if gs else 0.0,
+        sector_tiles=int(bool(gs and gs.tiles)),
+        goal_bearing=int(layout.goal_bearing),
+        n_inputs=layout.n_inputs,
+    )
+
+
 @nb.njit(cache=True)
-def read_sensors(
-    x,
-    y,
-    heading,
-    tx,
-    ty,
-    ray_angles,
-    max_range,
-    mount_radius,
-    sector_centres,
-    sector_width,
-    sector_tiles,
-    goal_bearing,
-    boxes,
-    candidates,
-    out,
-):
+def read_sensors(x, y, heading, tx, ty, layout, boxes, candidates, out):
     """Write the arbitrator inputs of a robot at pose ``(x, y, heading)`` into ``out``.
 
-    ``(tx, ty)`` is the goal (m, world). Rangefinder rays start at the mount point on the
-    body's edge; goal sectors and bearing come from the goal's bearing in the body frame.
+    ``(tx, ty)`` is the goal (m, world); ``layout`` a :class:`CompiledLayout`. Rangefinder
+    rays start at the mount point on the body's edge; goal sectors and bearing come from
+    the goal's bearing in the body frame.
     """
+    ray_angles = layout.ray_angles
+    max_range = layout.max_range
     n = 0
     for s in range(ray_angles.shape[0]):
         nearest = max_range
         for r in range(ray_angles.shape[1]):
             a = heading + ray_angles[s, r]
-            c = math.cos(a)
-            sn = math.sin(a)
-            d = cast_ray(
-                x + mount_radius * c, y + mount_radius * sn, a, max_range, boxes, candidates
-            )
-            nearest = min(nearest, d)
+            ox = x + layout.mount_radius * math.cos(a)
+            oy = y + layout.mount_radius * math.sin(a)
+            nearest = min(nearest, cast_ray(ox, oy, a, max_range, boxes, candidates))
         out[n] = range_reading(nearest, max_range)
         n += 1
-    if sector_centres.shape[0] > 0 or goal_bearing:
+    centres = layout.sector_centres
+    if centres.shape[0] > 0 or layout.goal_bearing:
         bearing = math.atan2(ty - y, tx - x) - heading
-        n_sectors = sector_centres.shape[0]
-        if sector_tiles:
-            lit = tiling_sector(bearing, sector_centres[0], sector_width, n_sectors)
+        n_sectors = centres.shape[0]
+        if layout.sector_tiles:
+            lit = tiling_sector(bearing, centres[0], layout.sector_width, n_sectors)
             for k in range(n_sectors):
                 out[n + k] = 1.0 if k == lit else 0.0
         else:
             for k in range(n_sectors):
-                out[n + k] = 1.0 if in_sector(bearing, sector_centres[k], sector_width) else 0.0
+                inside = in_sector(bearing, centres[k], layout.sector_width)
+                out[n + k] = 1.0 if inside else 0.0
         n += n_sectors
-        if goal_bearing:
+        if layout.goal_bearing:
             out[n] = goal_bearing_reading(bearing)

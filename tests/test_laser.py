@@ -9,7 +9,7 @@ from evorbc_ros.config import config_dir
 from evorbc_ros.laser import InputError, LaserPose, LaserToRangefinders
 from evorbc_ros.sensors import SensorLayout
 from sim_bridge.maze import load_named_maze
-from sim_bridge.sensors import CompiledLayout, read_sensors
+from sim_bridge.sensors import compile_layout, read_sensors
 from sim_bridge.world import LaserConfig, SimWorld
 
 LAYOUT = SensorLayout.load(config_dir() / "sensors" / "4ws.yaml")
@@ -148,7 +148,7 @@ def test_simulated_laser_gives_the_offline_readings():
     # LaserScan) through the laser node's code equals the offline sensors within 0.1 mm.
     maze = load_named_maze("obstacle")
     world = SimWorld(maze, laser=LaserConfig())
-    c = CompiledLayout(LAYOUT)
+    c = compile_layout(LAYOUT)
     converter = LaserToRangefinders(RF)
     out = np.empty(c.n_inputs)
     every = np.arange(len(maze.boxes), dtype=np.int64)
@@ -159,22 +159,7 @@ def test_simulated_laser_gives_the_offline_readings():
             ranges = world.scan().astype(np.float32)
             laser = world.laser
             got = converter.readings(laser.angle_min, laser.increment, ranges, 0.0, laser.range_max)
-            read_sensors(
-                x,
-                y,
-                h,
-                *maze.target,
-                c.ray_angles,
-                c.max_range,
-                c.mount_radius,
-                c.sector_centres,
-                c.sector_width,
-                c.sector_tiles,
-                c.goal_bearing,
-                maze.boxes,
-                every,
-                out,
-            )
+            read_sensors(x, y, h, *maze.target, c, maze.boxes, every, out)
             np.testing.assert_allclose(got, out[:6], atol=1e-4)  # 0.1 mm of 1 m
     finally:
         world.close()

@@ -120,23 +120,7 @@ def test_kernel_matches_the_onboard_controller_cycle_by_cycle(five_maze_task, sm
             for t in range(int(result.cycles[e])):
                 x, y, h = state[0, :3]
                 np.testing.assert_array_equal(result.pose[e, t], state[0, :3])
-                read_sensors(
-                    x,
-                    y,
-                    h,
-                    tx,
-                    ty,
-                    s.ray_angles,
-                    s.max_range,
-                    s.mount_radius,
-                    s.sector_centres,
-                    s.sector_width,
-                    s.sector_tiles,
-                    s.goal_bearing,
-                    boxes,
-                    every,
-                    inputs,
-                )
+                read_sensors(x, y, h, tx, ty, s, boxes, every, inputs)
                 choice, _ = onboard.choose(inputs)
                 assert choice == result.choice[e, t], (g, j, t)
                 command = controller.primitive_commands[choice]

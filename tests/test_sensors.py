@@ -33,13 +33,13 @@ from evorbc_ros.sensors import (
 from sim_bridge import sensors as compiled
 from sim_bridge.geometry import WallGrid, cast_ray, wall_boxes
 from sim_bridge.maze import load_named_maze
-from sim_bridge.sensors import CompiledLayout, read_sensors
+from sim_bridge.sensors import compile_layout, read_sensors
 
 TOL = 1e-12
 EPS = 1e-9  # "a hair"
 R = 0.05  # mount radius, m
 LAYOUT = SensorLayout.load(config_dir() / "sensors" / "4ws.yaml")
-COMPILED = CompiledLayout(LAYOUT)
+COMPILED = compile_layout(LAYOUT)
 ROOM = wall_boxes(np.array([[0, 0, 2, 0], [2, 0, 2, 1], [2, 1, 0, 1], [0, 1, 0, 0]], float), 0.01)
 FAR_GOAL = (100.0, 0.4)  # sectors are not under test where this goal is used
 
@@ -49,23 +49,7 @@ def read(x, y, heading, goal=FAR_GOAL, boxes=ROOM, layout=COMPILED, candidates=N
     if candidates is None:
         candidates = np.arange(len(boxes), dtype=np.int64)
     out = np.full(layout.n_inputs, np.nan)
-    read_sensors(
-        x,
-        y,
-        heading,
-        goal[0],
-        goal[1],
-        layout.ray_angles,
-        layout.max_range,
-        layout.mount_radius,
-        layout.sector_centres,
-        layout.sector_width,
-        layout.sector_tiles,
-        layout.goal_bearing,
-        boxes,
-        candidates,
-        out,
-    )
+    read_sensors(x, y, heading, goal[0], goal[1], layout, boxes, candidates, out)
     assert not np.isnan(out).any()  # every input was written
     return out
 
@@ -285,7 +269,7 @@ def test_field_of_view_reads_the_nearest_of_its_rays():
     # face (0.595 above the centre) is nearest along the steepest ray: 0.595 / sin 75 =
     # 0.615990 (45: 0.841457 to the top and to the right face alike; 60: 0.687047), so
     # d = 0.565990 and the reading is 0.434010 (the axis ray alone would give 0.362953).
-    layout = CompiledLayout(fov_layout())
+    layout = compile_layout(fov_layout())
     got = read(1.4, 0.4, 0.0, layout=layout)
     assert got[0] == pytest.approx(1 - (0.595 / math.sin(math.radians(75)) - R), abs=TOL)
     # The onboard formula from the five ray distances agrees bit for bit.
@@ -409,10 +393,10 @@ def test_goal_bearing_input():
     assert layout.input_names()[-1] == "goal_bearing" and layout.n_inputs == 6
     # Robot at (0.5, 0.5) heading 0, goal straight left: bearing pi/2 -> (pi/2 + pi) / 2pi =
     # 0.75. Rangefinder: mount radius 0 here, so d = 1.995 - 0.5 = 1.495 > 1: 0.
-    got = read(0.5, 0.5, 0.0, goal=(0.5, 1.5), layout=CompiledLayout(layout))
+    got = read(0.5, 0.5, 0.0, goal=(0.5, 1.5), layout=compile_layout(layout))
     np.testing.assert_array_equal(got, [0.0, *SECTOR_90, 0.75])
     # Only the goal bearing: ahead 0.5, behind 0 (pi wraps to -pi), right 0.25.
-    only = CompiledLayout(SensorLayout.from_dict({"goal_bearing": True}))
+    only = compile_layout(SensorLayout.from_dict({"goal_bearing": True}))
     assert read(0.5, 0.5, 0.0, goal=(1.5, 0.5), layout=only)[0] == 0.5
     assert read(0.5, 0.5, 0.0, goal=(-0.5, 0.5), layout=only)[0] == 0.0
     assert read(0.5, 0.5, 0.0, goal=(0.5, -0.5), layout=only)[0] == 0.25

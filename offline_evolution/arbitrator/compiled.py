@@ -186,22 +186,8 @@ def _aggregate(code, values, sources, weights, lo, hi):
 
 
 @nb.njit(cache=True)
-def activate(
-    g,
-    inputs,
-    values,
-    out,
-    node_start,
-    node_slot,
-    bias,
-    response,
-    activation,
-    aggregation,
-    link_start,
-    link_source,
-    link_weight,
-):
-    """Evaluate network ``g`` of a pack on ``inputs``; outputs go to ``out``.
+def activate(g, inputs, values, out, net):
+    """Evaluate network ``g`` of the :class:`NetworkPack` ``net``; outputs go to ``out``.
 
     ``values`` is scratch of at least the network's slot count. Slots are written in
     evaluation order, so only the inputs need setting first.
@@ -209,11 +195,18 @@ def activate(
     n_in = inputs.shape[0]
     for i in range(n_in):
         values[i] = inputs[i]
-    for k in range(node_start[g], node_start[g + 1]):
+    for k in range(net.node_start[g], net.node_start[g + 1]):
         s = _aggregate(
-            aggregation[k], values, link_source, link_weight, link_start[k], link_start[k + 1]
+            net.aggregation[k],
+            values,
+            net.link_source,
+            net.link_weight,
+            net.link_start[k],
+            net.link_start[k + 1],
         )
-        values[node_slot[k]] = activation_function(activation[k], bias[k] + response[k] * s)
+        values[net.node_slot[k]] = activation_function(
+            net.activation[k], net.bias[k] + net.response[k] * s
+        )
     for o in range(out.shape[0]):
         out[o] = values[n_in + o]
 
@@ -222,19 +215,5 @@ def activate_packed(pack: NetworkPack, g: int, inputs) -> np.ndarray:
     """Evaluate network ``g`` of ``pack`` from Python (tests and tools)."""
     values = np.zeros(int(pack.n_slots.max()))
     out = np.zeros(pack.n_outputs)
-    activate(
-        g,
-        np.asarray(inputs, dtype=np.float64),
-        values,
-        out,
-        pack.node_start,
-        pack.node_slot,
-        pack.bias,
-        pack.response,
-        pack.activation,
-        pack.aggregation,
-        pack.link_start,
-        pack.link_source,
-        pack.link_weight,
-    )
+    activate(g, np.asarray(inputs, dtype=np.float64), values, out, pack)
     return out

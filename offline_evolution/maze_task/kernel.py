@@ -39,95 +39,54 @@ def _lookup(x, y, origin, cell, table):
 
 
 @nb.njit(cache=True)
-def _candidates(
-    m,
-    x,
-    y,
-    mazes_grid_origin,
-    mazes_grid_shape,
-    grid_cell,
-    cell_base,
-    cell_offsets,
-    cell_ids,
-    all_start,
-    all_ids,
-):
-    base = cell_base[m]
-    nx = mazes_grid_shape[m, 0]
-    ny = mazes_grid_shape[m, 1]
+def _candidates(m, x, y, world):
+    """Wall rows near ``(x, y)`` in maze ``m`` of the :class:`MazePack` ``world``."""
+    base = world.cell_base[m]
+    nx = world.grid_shape[m, 0]
+    ny = world.grid_shape[m, 1]
     return grid_candidates(
         x,
         y,
-        mazes_grid_origin[m, 0],
-        mazes_grid_origin[m, 1],
-        grid_cell,
+        world.grid_origin[m, 0],
+        world.grid_origin[m, 1],
+        world.grid_cell,
         nx,
         ny,
-        cell_offsets[base : base + nx * ny + 1],
-        cell_ids,
-        all_ids[all_start[m] : all_start[m + 1]],
+        world.cell_offsets[base : base + nx * ny + 1],
+        world.cell_ids,
+        world.all_ids[world.all_start[m] : world.all_start[m + 1]],
     )
 
 
 @nb.njit(cache=True, parallel=True)
 def run_episodes(
-    # episodes
     genome,
     maze,
     start,
     n_cycles,
-    # networks (a NetworkPack)
-    node_start,
-    node_slot,
-    bias,
-    response,
-    activation,
-    aggregation,
-    link_start,
-    link_source,
-    link_weight,
-    max_slots,
-    n_outputs,
-    # mazes (a MazePack)
-    boxes,
-    grid_origin,
-    grid_shape,
-    grid_cell,
-    cell_base,
-    cell_offsets,
-    cell_ids,
-    all_start,
-    all_ids,
-    targets,
-    target_radius,
-    # sensors (a CompiledLayout)
-    ray_angles,
-    max_range,
-    mount_radius,
-    sector_centres,
-    sector_width,
-    sector_tiles,
-    goal_bearing,
-    n_inputs,
-    # controller
-    mode,
-    map_kind,
-    map_params,
-    lookup_origin,
-    lookup_cell,
-    lookup_table,
-    primitive_commands,
-    gene_matrix,
-    command_scale,
-    # robot
+    net,
+    world,
+    sensors,
+    controller,
     lim,
-    # recording (only if record; else pass 1-sized dummies)
     record,
     trace_pose,
     trace_choice,
     trace_outputs,
 ):
     """Run every episode ``e`` (genome ``genome[e]`` in maze ``maze[e]`` from ``start[e]``).
+
+    Args:
+        genome, maze: ``(E,)`` network and maze index of each episode.
+        start: ``(E, 3)`` start poses ``(x m, y m, heading rad)``.
+        n_cycles: episode length in control cycles.
+        net: :class:`~offline_evolution.arbitrator.compiled.NetworkPack`.
+        world: :class:`~offline_evolution.maze_task.world.MazePack`.
+        sensors: :class:`~sim_bridge.sensors.CompiledLayout`.
+        controller: :class:`~offline_evolution.maze_task.task.ControllerArrays`.
+        lim: :class:`~sim_bridge.four_ws_motion.MotionLimits`.
+        record: fill ``trace_pose (E, n_cycles + 1, 3)``, ``trace_choice (E, n_cycles)`` and
+            ``trace_outputs (E, n_cycles, n_outputs)``; otherwise they may be 1-sized.
 
     Returns:
         ``(reached (E,) bool, cycles (E,) int64, final_distance (E,), initial_distance (E,))``;
@@ -139,17 +98,18 @@ def run_episodes(
     final_distance = np.empty(n_ep)
     initial_distance = np.empty(n_ep)
     state = np.zeros((n_ep, STATE_SIZE))
+    max_slots = net.n_slots.max()
     for e in nb.prange(n_ep):
         g = genome[e]
         m = maze[e]
-        tx = targets[m, 0]
-        ty = targets[m, 1]
+        tx = world.targets[m, 0]
+        ty = world.targets[m, 1]
         state[e, X] = start[e, 0]
         state[e, Y] = start[e, 1]
         state[e, HEADING] = start[e, 2]
-        inputs = np.empty(n_inputs)
+        inputs = np.empty(sensors.n_inputs)
         values = np.empty(max_slots)
-        out = np.empty(n_outputs)
+        out = np.empty(net.n_outputs)
         command = np.empty(5)
         initial_distance[e] = math.hypot(start[e, 0] - tx, start[e, 1] - ty)
         dist = initial_distance[e]
@@ -157,74 +117,38 @@ def run_episodes(
             x = state[e, X]
             y = state[e, Y]
             h = state[e, HEADING]
-            cand = _candidates(
-                m,
-                x,
-                y,
-                grid_origin,
-                grid_shape,
-                grid_cell,
-                cell_base,
-                cell_offsets,
-                cell_ids,
-                all_start,
-                all_ids,
-            )
-            read_sensors(
-                x,
-                y,
-                h,
-                tx,
-                ty,
-                ray_angles,
-                max_range,
-                mount_radius,
-                sector_centres,
-                sector_width,
-                sector_tiles,
-                goal_bearing,
-                boxes,
-                cand,
-                inputs,
-            )
-            activate(
-                g,
-                inputs,
-                values,
-                out,
-                node_start,
-                node_slot,
-                bias,
-                response,
-                activation,
-                aggregation,
-                link_start,
-                link_source,
-                link_weight,
-            )
+            cand = _candidates(m, x, y, world)
+            read_sensors(x, y, h, tx, ty, sensors, world.boxes, cand, inputs)
+            activate(g, inputs, values, out, net)
             choice = -1
-            if mode == EVORBC:
-                px, py = map_point(map_kind, map_params, out[0], out[1])
-                choice = _lookup(px, py, lookup_origin, lookup_cell, lookup_table)
+            if controller.mode == EVORBC:
+                px, py = map_point(controller.map_kind, controller.map_params, out[0], out[1])
+                choice = _lookup(
+                    px,
+                    py,
+                    controller.lookup_origin,
+                    controller.lookup_cell,
+                    controller.lookup_table,
+                )
                 for c in range(5):
-                    command[c] = primitive_commands[choice, c]
+                    command[c] = controller.primitive_commands[choice, c]
             else:
                 for c in range(5):
                     acc = 0.0
-                    for k in range(n_outputs):
+                    for k in range(net.n_outputs):
                         gene = 2.0 * min(max(out[k], 0.0), 1.0) - 1.0
-                        acc += gene * gene_matrix[k, c]
-                    command[c] = acc * command_scale[c]
+                        acc += gene * controller.gene_matrix[k, c]
+                    command[c] = acc * controller.command_scale[c]
             if record:
                 trace_pose[e, t, 0] = x
                 trace_pose[e, t, 1] = y
                 trace_pose[e, t, 2] = h
                 trace_choice[e, t] = choice
-                for k in range(n_outputs):
+                for k in range(net.n_outputs):
                     trace_outputs[e, t, k] = out[k]
-            step_robot(state, e, command, lim, boxes, cand)
+            step_robot(state, e, command, lim, world.boxes, cand)
             dist = math.hypot(state[e, X] - tx, state[e, Y] - ty)
-            if dist <= target_radius[m]:
+            if dist <= world.target_radius[m]:
                 reached[e] = True
                 cycles[e] = t + 1
                 break

@@ -28,7 +28,7 @@ from offline_evolution.maze_task.world import pack_mazes
 from sim_bridge.maze import load_named_maze
 from sim_bridge.robots.base import control_steps
 from sim_bridge.robots.four_ws import FourWSRobot
-from sim_bridge.sensors import CompiledLayout
+from sim_bridge.sensors import compile_layout
 
 #: Episodes handed to a worker thread at a time: small enough to balance episodes that end
 #: early (target reached) against ones that run the full 120 s.
@@ -64,7 +64,8 @@ class ControllerArrays(NamedTuple):
 
     mode: int
     map_kind: int
-    map_params: tuple[float, float, float, float]
+    map_params: np.ndarray  # (4,) MappingFunction.params (an array: numba's parfors take no
+    # tuples inside tuples)
     lookup_origin: np.ndarray  # (2,)
     lookup_cell: np.ndarray  # (2,)
     lookup_table: np.ndarray  # (nx, ny) int64
@@ -83,7 +84,7 @@ def evorbc_controller(
     return ControllerArrays(
         EVORBC,
         fn.kind,
-        fn.params,
+        np.array(fn.params, dtype=np.float64),
         np.array(lookup.origin),
         np.array(lookup.cell),
         lookup.table,
@@ -100,7 +101,7 @@ def standard_controller(robot: FourWSRobot) -> ControllerArrays:
     return ControllerArrays(
         STANDARD,
         0,
-        (0.0, 0.0, 0.0, 0.0),
+        np.zeros(4),
         np.zeros(2),
         np.ones(2),
         np.zeros((1, 1), dtype=np.int64),
@@ -131,7 +132,7 @@ class MazeTask:
         self.robot = FourWSRobot(robot)
         self.mazes = [load_named_maze(name) for name in settings.mazes]
         self.layout = SensorLayout.load(config_dir() / settings.sensors)
-        self.sensors = CompiledLayout(self.layout)
+        self.sensors = compile_layout(self.layout)
         self.dt = self.robot.control_period
         self.n_cycles = control_steps(settings.episode_time, self.dt)
         # Walls a ray or the footprint can touch from a cell: sensor reach plus a step and
@@ -184,52 +185,16 @@ class MazeTask:
             pose = np.zeros((1, 1, 3))
             choice = np.zeros((1, 1), dtype=np.int64)
             outputs = np.zeros((1, 1, 1))
-        n, p, s, c = networks, self.pack, self.sensors, controller
         with numba.parallel_chunksize(_CHUNK):
             reached, cycles, final, initial = run_episodes(
                 genome,
                 maze,
                 start,
                 self.n_cycles,
-                n.node_start,
-                n.node_slot,
-                n.bias,
-                n.response,
-                n.activation,
-                n.aggregation,
-                n.link_start,
-                n.link_source,
-                n.link_weight,
-                int(n.n_slots.max()),
-                n.n_outputs,
-                p.boxes,
-                p.grid_origin,
-                p.grid_shape,
-                p.grid_cell,
-                p.cell_base,
-                p.cell_offsets,
-                p.cell_ids,
-                p.all_start,
-                p.all_ids,
-                p.targets,
-                p.target_radius,
-                s.ray_angles,
-                s.max_range,
-                s.mount_radius,
-                s.sector_centres,
-                s.sector_width,
-                s.sector_tiles,
-                s.goal_bearing,
-                s.n_inputs,
-                c.mode,
-                c.map_kind,
-                c.map_params,
-                c.lookup_origin,
-                c.lookup_cell,
-                c.lookup_table,
-                c.primitive_commands,
-                c.gene_matrix,
-                c.command_scale,
+                networks,
+                self.pack,
+                self.sensors,
+                controller,
                 self.robot.limits,
                 record,
                 pose,

@@ -1,0 +1,38 @@
+"""Reading the JSON files users exchange, with one-line errors that name the file."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+
+def load_json_file(path: str | os.PathLike, what: str, error: type[Exception]) -> Any:
+    """Parse the JSON file at ``path``.
+
+    Args:
+        what: what the file should be (``"repertoire"``), for the messages.
+        error: the exception class to raise.
+
+    Raises:
+        ``error``: missing, unreadable, not UTF-8, or truncated/corrupt JSON, in one line
+        that starts with the path.
+    """
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise error(f"{source}: no such {what} file") from None
+    except UnicodeDecodeError:
+        raise error(f"{source}: not a {what} file (not UTF-8 text)") from None
+    except OSError as e:
+        raise error(f"{source}: cannot read ({e.strerror})") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as e:
+        kind = "truncated" if e.pos >= len(text.rstrip()) else "corrupt"
+        raise error(
+            f"{source}: {kind} {what} file (invalid JSON at line {e.lineno}, "
+            f"column {e.colno}: {e.msg})"
+        ) from None
