@@ -9,10 +9,11 @@ ros2_control commands ``steering_position_controller/commands`` (rad) and
 mean times the wheel radius).
 
 Modes:
-* ``lockstep``: publish the state, wait for one new message on both command topics, step
-  0.1 s, repeat: deterministic and as fast as the graph answers. If no command comes within
-  ``lockstep_timeout`` s of wall time the state is published again (a restarted node then
-  picks the run up where it was).
+* ``lockstep``: wait until the graph is connected; then publish the state, wait for one new
+  message on both command topics, step 0.1 s, repeat: deterministic and as fast as the
+  graph answers. A slow node is waited for. If a node leaves the graph and comes back (a
+  restart), the state is published again and the run goes on where it was; so it is after
+  ``lockstep_timeout`` s without commands.
 * ``realtime``: step every 0.1 s of wall time with the latest commands.
 
 The episode ends at the target or after ``episode_time``; the result (reached, time,
@@ -83,8 +84,8 @@ class SimBridgeNode(Node):
         self.lockstep_timeout = finite_parameter(
             self,
             "lockstep_timeout",
-            2.0,
-            "wall seconds before the state is sent again",
+            30.0,
+            "wall seconds without commands before the state is sent again anyway",
             positive=True,
         )
         self.wait_subscribers = declare(
@@ -252,6 +253,17 @@ class SimBridgeNode(Node):
 
     # -- running -----------------------------------------------------------------------
 
+    def missing(self) -> list[str]:
+        """The graph topics that have no subscriber or publisher (a node is down)."""
+        out = [t for t in self.wait_subscribers if self.count_subscribers(t) == 0]
+        return out + [t for t in self.wait_publishers if self.count_publishers(t) == 0]
+
+    def spin_for(self, executor, seconds: float) -> None:
+        """Process messages for ``seconds`` of wall time."""
+        until = time.monotonic() + seconds
+        while time.monotonic() < until and rclpy.ok():
+            executor.spin_once(timeout_sec=0.05)
+
     def wait_for_graph(self, executor) -> None:
         """Wait until the controller's nodes are connected, so no first message is lost.
 
@@ -259,21 +271,44 @@ class SimBridgeNode(Node):
         already seen it would then answer twice.
         """
         deadline = time.monotonic() + self.startup_timeout
-
-        def missing() -> list[str]:
-            out = [t for t in self.wait_subscribers if self.count_subscribers(t) == 0]
-            return out + [t for t in self.wait_publishers if self.count_publishers(t) == 0]
-
-        while missing() and time.monotonic() < deadline and rclpy.ok():
+        while self.missing() and time.monotonic() < deadline and rclpy.ok():
             executor.spin_once(timeout_sec=0.05)
-        if missing():
-            self.get_logger().warning(f"starting without {', '.join(missing())}")
+        if self.missing():
+            self.get_logger().warning(f"starting without {', '.join(self.missing())}")
             return
         # Both ends of a new DDS connection match at about the same time; give the far
         # end a moment before the first reliable message.
-        settle = time.monotonic() + 0.3
-        while time.monotonic() < settle:
-            executor.spin_once(timeout_sec=0.05)
+        self.spin_for(executor, 0.3)
+
+    def wait_for_commands(self, executor) -> None:
+        """Wait for this cycle's commands, sending the state again only if it was lost.
+
+        A slow node is simply waited for: sending the state twice would make the nodes
+        that already answered answer twice, and the extra commands would be taken for the
+        next cycle's. The state is sent again when a node has left the graph and come
+        back (a restart), or, as a last resort, after ``lockstep_timeout`` s.
+        """
+        sent = checked = time.monotonic()
+        node_left = False
+        while not all(self.fresh.values()) and rclpy.ok():
+            executor.spin_once(timeout_sec=0.01)
+            now = time.monotonic()
+            if now - checked > 0.1:
+                checked = now
+                gone = self.missing()
+                if gone and not node_left:
+                    self.get_logger().warning(f"lost {', '.join(gone)}; waiting for it")
+                node_left = node_left or bool(gone)
+                rejoined = node_left and not gone
+            else:
+                rejoined = False
+            if rejoined or now - sent > self.lockstep_timeout:
+                if rejoined:
+                    self.spin_for(executor, 0.3)  # let the new node's connections settle
+                self.get_logger().info(f"sending the state again for t = {self.world.time:.1f} s")
+                self.publish_state()
+                sent = time.monotonic()
+                node_left = False
 
     def run_lockstep(self) -> None:
         """The lockstep loop: state out, both commands in, step."""
@@ -285,17 +320,7 @@ class SimBridgeNode(Node):
             while not self.world.status().done and rclpy.ok():
                 self.fresh = {"steering": False, "wheel": False}
                 self.publish_state()
-                sent = time.monotonic()
-                while not all(self.fresh.values()) and rclpy.ok():
-                    executor.spin_once(timeout_sec=0.01)
-                    if time.monotonic() - sent > self.lockstep_timeout:
-                        self.get_logger().info(
-                            f"no command for t = {self.world.time:.1f} s "
-                            "yet; sending the state again",
-                            throttle_duration_sec=5.0,
-                        )
-                        self.publish_state()
-                        sent = time.monotonic()
+                self.wait_for_commands(executor)
                 self.advance()
             self.publish_state()  # final state for listeners
         finally:
