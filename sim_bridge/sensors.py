@@ -73,29 +73,29 @@ def read_sensors(x, y, heading, tx, ty, layout, boxes, candidates, out):
     rays start at the mount point on the body's edge; goal sectors and bearing come from
     the goal's bearing in the body frame.
     """
-    ray_angles = layout.ray_angles
-    max_range = layout.max_range
+    # Fields as locals: numba does not hoist NamedTuple loads out of the loops.
+    ray_angles, max_range, mount = layout.ray_angles, layout.max_range, layout.mount_radius
+    centres, width = layout.sector_centres, layout.sector_width
     n = 0
     for s in range(ray_angles.shape[0]):
         nearest = max_range
         for r in range(ray_angles.shape[1]):
             a = heading + ray_angles[s, r]
-            ox = x + layout.mount_radius * math.cos(a)
-            oy = y + layout.mount_radius * math.sin(a)
+            ox = x + mount * math.cos(a)
+            oy = y + mount * math.sin(a)
             nearest = min(nearest, cast_ray(ox, oy, a, max_range, boxes, candidates))
         out[n] = range_reading(nearest, max_range)
         n += 1
-    centres = layout.sector_centres
     if centres.shape[0] > 0 or layout.goal_bearing:
         bearing = math.atan2(ty - y, tx - x) - heading
         n_sectors = centres.shape[0]
         if layout.sector_tiles:
-            lit = tiling_sector(bearing, centres[0], layout.sector_width, n_sectors)
+            lit = tiling_sector(bearing, centres[0], width, n_sectors)
             for k in range(n_sectors):
                 out[n + k] = 1.0 if k == lit else 0.0
         else:
             for k in range(n_sectors):
-                inside = in_sector(bearing, centres[k], layout.sector_width)
+                inside = in_sector(bearing, centres[k], width)
                 out[n + k] = 1.0 if inside else 0.0
         n += n_sectors
         if layout.goal_bearing:

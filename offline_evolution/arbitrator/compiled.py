@@ -192,21 +192,18 @@ def activate(g, inputs, values, out, net):
     ``values`` is scratch of at least the network's slot count. Slots are written in
     evaluation order, so only the inputs need setting first.
     """
+    # Fields as locals: numba does not hoist NamedTuple loads out of the loop.
+    node_start, node_slot, bias, response = net.node_start, net.node_slot, net.bias, net.response
+    activation, aggregation = net.activation, net.aggregation
+    link_start, link_source, link_weight = net.link_start, net.link_source, net.link_weight
     n_in = inputs.shape[0]
     for i in range(n_in):
         values[i] = inputs[i]
-    for k in range(net.node_start[g], net.node_start[g + 1]):
+    for k in range(node_start[g], node_start[g + 1]):
         s = _aggregate(
-            net.aggregation[k],
-            values,
-            net.link_source,
-            net.link_weight,
-            net.link_start[k],
-            net.link_start[k + 1],
+            aggregation[k], values, link_source, link_weight, link_start[k], link_start[k + 1]
         )
-        values[net.node_slot[k]] = activation_function(
-            net.activation[k], net.bias[k] + net.response[k] * s
-        )
+        values[node_slot[k]] = activation_function(activation[k], bias[k] + response[k] * s)
     for o in range(out.shape[0]):
         out[o] = values[n_in + o]
 

@@ -99,17 +99,24 @@ def run_episodes(
     initial_distance = np.empty(n_ep)
     state = np.zeros((n_ep, STATE_SIZE))
     max_slots = net.n_slots.max()
+    n_outputs = net.n_outputs
+    # Fields the loop reads every cycle, as locals: numba does not hoist NamedTuple loads.
+    boxes, targets, target_radius = world.boxes, world.targets, world.target_radius
+    mode, map_kind, map_params = controller.mode, controller.map_kind, controller.map_params
+    lookup_origin, lookup_cell = controller.lookup_origin, controller.lookup_cell
+    lookup_table, primitive_commands = controller.lookup_table, controller.primitive_commands
+    gene_matrix, command_scale = controller.gene_matrix, controller.command_scale
     for e in nb.prange(n_ep):
         g = genome[e]
         m = maze[e]
-        tx = world.targets[m, 0]
-        ty = world.targets[m, 1]
+        tx = targets[m, 0]
+        ty = targets[m, 1]
         state[e, X] = start[e, 0]
         state[e, Y] = start[e, 1]
         state[e, HEADING] = start[e, 2]
         inputs = np.empty(sensors.n_inputs)
         values = np.empty(max_slots)
-        out = np.empty(net.n_outputs)
+        out = np.empty(n_outputs)
         command = np.empty(5)
         initial_distance[e] = math.hypot(start[e, 0] - tx, start[e, 1] - ty)
         dist = initial_distance[e]
@@ -118,37 +125,31 @@ def run_episodes(
             y = state[e, Y]
             h = state[e, HEADING]
             cand = _candidates(m, x, y, world)
-            read_sensors(x, y, h, tx, ty, sensors, world.boxes, cand, inputs)
+            read_sensors(x, y, h, tx, ty, sensors, boxes, cand, inputs)
             activate(g, inputs, values, out, net)
             choice = -1
-            if controller.mode == EVORBC:
-                px, py = map_point(controller.map_kind, controller.map_params, out[0], out[1])
-                choice = _lookup(
-                    px,
-                    py,
-                    controller.lookup_origin,
-                    controller.lookup_cell,
-                    controller.lookup_table,
-                )
+            if mode == EVORBC:
+                px, py = map_point(map_kind, map_params, out[0], out[1])
+                choice = _lookup(px, py, lookup_origin, lookup_cell, lookup_table)
                 for c in range(5):
-                    command[c] = controller.primitive_commands[choice, c]
+                    command[c] = primitive_commands[choice, c]
             else:
                 for c in range(5):
                     acc = 0.0
-                    for k in range(net.n_outputs):
+                    for k in range(n_outputs):
                         gene = 2.0 * min(max(out[k], 0.0), 1.0) - 1.0
-                        acc += gene * controller.gene_matrix[k, c]
-                    command[c] = acc * controller.command_scale[c]
+                        acc += gene * gene_matrix[k, c]
+                    command[c] = acc * command_scale[c]
             if record:
                 trace_pose[e, t, 0] = x
                 trace_pose[e, t, 1] = y
                 trace_pose[e, t, 2] = h
                 trace_choice[e, t] = choice
-                for k in range(net.n_outputs):
+                for k in range(n_outputs):
                     trace_outputs[e, t, k] = out[k]
-            step_robot(state, e, command, lim, world.boxes, cand)
+            step_robot(state, e, command, lim, boxes, cand)
             dist = math.hypot(state[e, X] - tx, state[e, Y] - ty)
-            if dist <= world.target_radius[m]:
+            if dist <= target_radius[m]:
                 reached[e] = True
                 cycles[e] = t + 1
                 break
