@@ -57,6 +57,16 @@ def arbitrator_latency(cycles: int = 2000) -> tuple[list[float], list[float]]:
     executor.add_node(node)
     executor.add_node(probe)
     got = []
+    callback = []  # time inside the arbitrator's callback for the completing message
+    original = node.on_input
+
+    def timed(topic, msg):
+        t0 = time.perf_counter()
+        original(topic, msg)
+        if topic == "evorbc/goal_sectors":
+            callback.append(time.perf_counter() - t0)
+
+    node.on_input = timed  # the node's subscriptions look the method up at call time
     probe.create_subscription(
         Float64MultiArray, "evorbc/primitive", lambda m: got.append(time.perf_counter()), RELIABLE
     )
@@ -87,7 +97,7 @@ def arbitrator_latency(cycles: int = 2000) -> tuple[list[float], list[float]]:
         t0 = time.perf_counter()
         controller.step(x)
         pure.append(time.perf_counter() - t0)
-    return latencies, pure
+    return latencies, pure, callback
 
 
 def graph_run(maze: str, mode: str, episode_time: float, domain: int) -> dict:
@@ -144,10 +154,14 @@ def percentiles(values, scale=1e3) -> str:
 
 def main() -> None:
     print(f"machine: {machine()}")
-    latencies, pure = arbitrator_latency()
+    latencies, pure, callback = arbitrator_latency()
     print(
         "\narbitrator node, message in -> primitive out (ms, in process over DDS): "
         + percentiles(latencies)
+    )
+    print(
+        "arbitrator node callback, message received -> primitive published (ms): "
+        + percentiles(callback)
     )
     print("arbitrator choice alone (network, mapping, lookup; ms): " + percentiles(pure))
 

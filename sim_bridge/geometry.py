@@ -94,19 +94,26 @@ def ray_box(ox, oy, dx, dy, boxes, k):
 
 
 @nb.njit(cache=True)
-def cast_ray(ox, oy, angle, max_range, boxes, candidates):
-    """Distance (m) along a ray to the nearest candidate box, capped at ``max_range``.
+def cast_ray_dir(ox, oy, dx, dy, max_range, boxes, candidates):
+    """Distance (m) to the nearest candidate box along a unit ray, capped at ``max_range``.
 
-    The ray starts at ``(ox, oy)`` and points along ``angle`` (rad, world frame).
+    The ray is ``(ox, oy) + t (dx, dy)`` with ``(dx, dy)`` of length 1 (world frame).
     """
-    dx = math.cos(angle)
-    dy = math.sin(angle)
     best = max_range
     for j in range(candidates.shape[0]):
         d = ray_box(ox, oy, dx, dy, boxes, candidates[j])
         if d < best:
             best = d
     return best
+
+
+@nb.njit(cache=True)
+def cast_ray(ox, oy, angle, max_range, boxes, candidates):
+    """Distance (m) along a ray to the nearest candidate box, capped at ``max_range``.
+
+    The ray starts at ``(ox, oy)`` and points along ``angle`` (rad, world frame).
+    """
+    return cast_ray_dir(ox, oy, math.cos(angle), math.sin(angle), max_range, boxes, candidates)
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ import numpy as np
 
 from evorbc_ros import sensors as onboard
 from evorbc_ros.sensors import SensorLayout
-from sim_bridge.geometry import cast_ray
+from sim_bridge.geometry import cast_ray_dir
 
 range_reading = nb.njit(cache=True)(onboard.range_reading)
 in_sector = nb.njit(cache=True)(onboard.in_sector)
@@ -81,9 +81,10 @@ def read_sensors(x, y, heading, tx, ty, layout, boxes, candidates, out):
         nearest = max_range
         for r in range(ray_angles.shape[1]):
             a = heading + ray_angles[s, r]
-            ox = x + mount * math.cos(a)
-            oy = y + mount * math.sin(a)
-            nearest = min(nearest, cast_ray(ox, oy, a, max_range, boxes, candidates))
+            dx = math.cos(a)
+            dy = math.sin(a)
+            d = cast_ray_dir(x + mount * dx, y + mount * dy, dx, dy, max_range, boxes, candidates)
+            nearest = min(nearest, d)
         out[n] = range_reading(nearest, max_range)
         n += 1
     if centres.shape[0] > 0 or layout.goal_bearing:

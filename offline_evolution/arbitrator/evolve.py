@@ -183,7 +183,9 @@ class Evolution:
         reached = result.reached.reshape(len(specs), len(starts)).sum(axis=1)
         for (_, genome), f in zip(genomes, fitness, strict=True):
             genome.fitness = float(f)
-        self.hall.update([genome_to_dict(g) for _, g in genomes])
+        # Only the top of a generation can enter the hall: convert just those to dicts.
+        ranked = sorted((g for _, g in genomes), key=lambda g: (-g.fitness, g.key))
+        self.hall.update([genome_to_dict(g) for g in ranked[: self.hall.size]])
         self._eval_seconds = time.perf_counter() - start
         k = int(np.argmax(fitness))
         if self.best is None or fitness[k] > self.best["fitness"]:

@@ -94,6 +94,15 @@ def run_one(robot: str, kind: str, seed: int, generations: int, runs: Path) -> d
     return json.loads(out.read_text())["evolution"]
 
 
+def finished_seeds(robots, seeds, runs: Path) -> list[int]:
+    """The seeds whose runs (every robot, both methods) are all done."""
+    return [
+        s
+        for s in seeds
+        if all((runs / f"{r}-{m}-seed{s}.json").exists() for r in robots for m in METHODS)
+    ]
+
+
 def summarise(robots, seeds, generations, runs: Path, out: Path) -> str:
     """Aggregate the runs into a Markdown table and a fitness-curve picture per robot."""
     from offline_evolution.plots.fitness import plot_fitness_comparison
@@ -149,11 +158,20 @@ def main() -> None:
         help="default: Table I (config/arbitrator/4ws.yaml)",
     )
     parser.add_argument("--out", type=Path, default=Path("docs"))
+    parser.add_argument(
+        "--summarise-only",
+        action="store_true",
+        help="only tabulate the seeds whose runs are all done",
+    )
     args = parser.parse_args()
     generations = args.generations or load_run_settings(robot=args.robots[0]).generations
     runs = args.out / "runs"
     runs.mkdir(parents=True, exist_ok=True)
     seeds = list(range(1, args.seeds + 1))
+    if args.summarise_only:
+        seeds = finished_seeds(args.robots, seeds, runs)
+        if len(seeds) < 2:
+            raise SystemExit(f"{runs}: fewer than two seeds are finished")
     for seed in seeds:  # seed-major, so every method has results early
         for robot in args.robots:
             for kind in METHODS:
