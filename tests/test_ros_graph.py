@@ -5,7 +5,9 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -168,3 +170,50 @@ def test_nodes_refuse_bad_parameters_with_one_line(tmp_path):
     cmd = node_command("sim_bridge.bridge_node", {"maze": "labyrinth"})
     done = subprocess.run(cmd, env=graph_env(163), capture_output=True, text=True, timeout=60)
     assert done.returncode == 2 and "unknown maze 'labyrinth'" in done.stderr
+
+
+def test_evorbc_sim_stops_the_whole_graph_on_ctrl_c(tmp_path):
+    env = graph_env(164)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "sim_bridge.bringup",
+            "--maze",
+            "obstacle",
+            "--mode",
+            "realtime",
+            "--plot",
+            str(tmp_path / "run.png"),
+        ],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=tmp_path,
+    )
+    deadline = time.monotonic() + 60
+    seen = ""
+    while "t =  10.0 s" not in seen and time.monotonic() < deadline:
+        line = proc.stderr.readline()
+        assert line, "the graph ended early"
+        seen += line
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130
+    assert "stopping the graph" in err
+    assert "did not reach the target" in out  # the partial run is still reported and drawn
+    assert (tmp_path / "run.png").exists()
+    assert not processes_with_env("ROS_DOMAIN_ID=164"), "nodes outlived evorbc-sim"
+
+
+def processes_with_env(entry: str) -> list[int]:
+    """PIDs of processes whose environment contains ``entry`` (``NAME=value``)."""
+    found = []
+    for environ in Path("/proc").glob("[0-9]*/environ"):
+        try:
+            if entry.encode() in environ.read_bytes().split(b"\0"):
+                found.append(int(environ.parent.name))
+        except OSError:
+            continue  # the process ended or is not ours to read
+    return found
