@@ -40,6 +40,12 @@ class LaserPose:
     yaw: float = 0.0
 
 
+#: Slack (rad) when deciding whether a beam lies in a field of view or on an axis. LaserScan
+#: angles are float32, rounded by up to about 1e-7 rad, and a layout's edge beams lie
+#: exactly on its field-of-view edges.
+ANGLE_TOLERANCE = 1e-6
+
+
 def _wrap(angle: np.ndarray) -> np.ndarray:
     return np.mod(angle + np.pi, 2.0 * np.pi) - np.pi
 
@@ -95,17 +101,16 @@ class LaserToRangefinders:
         from_centre = np.where(finite, np.hypot(hx, hy), np.inf)
         from_mount = np.maximum(from_centre - self.layout.mount_radius, 0.0)
 
-        out = np.empty(len(self.axes))
+        # (n_axes, n_beams) angle of each beam from each rangefinder's axis.
+        offset = np.abs(_wrap(direction[None, :] - self.axes[:, None]))
         half_fov = 0.5 * self.layout.field_of_view
-        half_gap = 0.5 * abs(angle_increment)
-        for k, axis in enumerate(self.axes):
-            offset = np.abs(_wrap(direction - axis))
-            if half_fov > 0.0:
-                members = valid & (offset <= half_fov + 1e-12)
-                d = np.min(from_mount[members], initial=np.inf)
-            else:
-                candidates = np.where(valid, offset, np.inf)
-                j = int(np.argmin(candidates))
-                d = from_mount[j] if candidates[j] <= half_gap + 1e-12 else np.inf
-            out[k] = range_reading(d, self.layout.max_range)
-        return out
+        if half_fov > 0.0:
+            members = valid[None, :] & (offset <= half_fov + ANGLE_TOLERANCE)
+            nearest = np.where(members, from_mount[None, :], np.inf).min(axis=1)
+        else:
+            # One ray: the beam nearest the axis (first of equals), if within half a gap.
+            candidates = np.where(valid[None, :], offset, np.inf)
+            j = np.argmin(candidates, axis=1)
+            close = candidates[np.arange(len(j)), j] <= 0.5 * abs(angle_increment) + ANGLE_TOLERANCE
+            nearest = np.where(close, from_mount[j], np.inf)
+        return np.array([range_reading(float(d), self.layout.max_range) for d in nearest])

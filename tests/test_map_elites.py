@@ -51,6 +51,7 @@ def test_paper_mutation_changes_a_quarter_of_the_genes_by_half_a_unit():
     )
     first = emitter.ask()
     assert first.shape == (10, 5) and np.all(np.abs(first) <= 1)
+    assert np.all(first != 0.0)  # random, not mutants of the one elite
     mutants = emitter.ask()
     assert mutants.shape == (40000, 5)
     changed = mutants != 0.0
@@ -62,6 +63,34 @@ def test_paper_mutation_changes_a_quarter_of_the_genes_by_half_a_unit():
     assert np.mean(np.abs(mutants[changed]) == 1.0) == pytest.approx(0.0455, abs=0.01)
 
 
+def test_initial_batch_comes_in_pieces_drawn_as_one_batch():
+    archive = make_archive(grid_layout(0.4, 0.04), solution_dim=3, seed=0)
+    emitter = PaperMutationEmitter(
+        archive, initial_batch=250, batch_size=100, mutation_probability=0.25, sigma=0.5, seed=4
+    )
+    pieces = [emitter.ask() for _ in range(3)]
+    assert [len(p) for p in pieces] == [100, 100, 50]
+    whole = np.random.default_rng(4).uniform(-1.0, 1.0, size=(250, 3))
+    np.testing.assert_array_equal(np.concatenate(pieces), whole)
+    # Nothing in the archive after the initial batch: more random solutions, not mutants.
+    assert emitter.ask().shape == (100, 3)
+
+
+def test_behaviours_outside_the_archive_are_dropped_not_clipped():
+    from sim_bridge.robots.base import PrimitiveOutcome
+
+    run = MapElites(small_settings())
+    edge = run.layout["high"][0]
+    outcome = PrimitiveOutcome(
+        x=np.array([0.1, edge + 0.01]),
+        y=np.array([0.0, 0.0]),
+        heading=np.zeros(2),
+        path=np.array([0.1, edge]),
+    )
+    run.tell(np.zeros((2, 5)), outcome)
+    assert len(run.archive) == 1 and run.discarded == 1
+
+
 def test_same_seed_same_repertoire_and_other_seed_differs(small_repertoire):
     assert_same_repertoire(small_repertoire, generate_repertoire(small_settings()))
     other = generate_repertoire(small_settings(seed=8))
@@ -70,24 +99,28 @@ def test_same_seed_same_repertoire_and_other_seed_differs(small_repertoire):
     )
 
 
-def test_resumed_run_equals_an_uninterrupted_run(tmp_path, small_repertoire):
+@pytest.mark.parametrize("stop_at_batch, iteration", [(2, 0), (16, 12)])
+def test_resumed_run_equals_an_uninterrupted_run(
+    tmp_path, small_repertoire, stop_at_batch, iteration
+):
+    # The initial batch of 400 comes in 4 pieces of the batch size (100): batch 2 is
+    # inside it, batch 16 is iteration 12.
     ckpt = tmp_path / "run.checkpoint.npz"
     polls = []
 
-    def stop_after_twelve():
+    def stop():
         polls.append(1)
-        return len(polls) == 13  # batch 13 = iteration 12
+        return len(polls) == stop_at_batch
 
     with pytest.raises(Interrupted) as info:
-        generate_repertoire(
-            small_settings(), checkpoint=ckpt, checkpoint_every=5, should_stop=stop_after_twelve
-        )
-    assert info.value.iteration == 12 and ckpt.exists()
+        generate_repertoire(small_settings(), checkpoint=ckpt, checkpoint_every=5, should_stop=stop)
+    assert info.value.iteration == iteration and ckpt.exists()
     seen = []
     resumed = generate_repertoire(
         small_settings(), checkpoint=ckpt, checkpoint_every=5, progress=seen.append
     )
-    assert seen[0].resumed_from == 12 and seen[0].iteration == 13
+    assert seen[0].resumed_from == iteration
+    assert seen[0].evaluations == 100 * (stop_at_batch + 1)
     assert resumed.algorithm["evaluations"] == small_settings().evaluations
     assert_same_repertoire(resumed, small_repertoire)
     assert not ckpt.exists()  # a finished run removes its checkpoint

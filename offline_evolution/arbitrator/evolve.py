@@ -29,7 +29,6 @@ from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.network import ConnectionSpec, NetworkSpec, NodeSpec
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.arbitrator.compiled import pack_networks
 from offline_evolution.arbitrator.neat_config import load_neat_config
 from offline_evolution.arbitrator.neat_state import (
     genome_from_dict,
@@ -44,12 +43,7 @@ from offline_evolution.arbitrator.selection import (
     post_evaluation_starts,
 )
 from offline_evolution.checkpoint import CheckpointError, Interrupted, settings_mismatch
-from offline_evolution.maze_task.task import (
-    MazeTask,
-    MazeTaskSettings,
-    evorbc_controller,
-    standard_controller,
-)
+from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings, make_task
 
 CHECKPOINT_KIND = "evorbc-neat-checkpoint"
 #: Extra generations that give standard NEAT EvoRBC's budget: the 4WS repertoire costs
@@ -142,17 +136,21 @@ def file_sha256(path: str | os.PathLike) -> str:
 class Evolution:
     """One NEAT run on the maze task."""
 
-    def __init__(self, settings: EvolutionSettings, repertoire: Repertoire | None = None):
+    def __init__(
+        self,
+        settings: EvolutionSettings,
+        repertoire: Repertoire | None = None,
+        workers: int | None = None,
+    ):
         self.settings = settings
-        self.task = MazeTask(MazeTaskSettings(**settings.task), settings.robot)
+        self.task = make_task(MazeTaskSettings(**settings.task), settings.robot, workers)
         if settings.kind == "evorbc":
             if repertoire is None:
                 raise ValueError("EvoRBC evolution needs a repertoire")
-            self.controller = evorbc_controller(repertoire, settings.mapping, self.task.robot)
             n_outputs = 2
         else:
-            self.controller = standard_controller(self.task.robot)
-            n_outputs = self.task.robot.type.n_parameters
+            n_outputs = self.task.n_standard_outputs
+        self.controller = self.task.controller(settings.kind, repertoire, settings.mapping)
         self.config = load_neat_config(settings.neat_file, self.task.layout.n_inputs, n_outputs)
         self.population = neat.Population(self.config, seed=settings.seed)
         self.history: list[GenerationStats] = []
@@ -178,7 +176,7 @@ class Evolution:
         specs = [network_spec(g, config) for _, g in genomes]
         rng = np.random.default_rng([self.settings.seed, generation])
         starts = self.task.sample_starts(rng)
-        result = self.task.run(pack_networks(specs), self.controller, np.arange(len(specs)), starts)
+        result = self.task.evaluate(specs, self.controller, starts)
         fitness = result.fitness.reshape(len(specs), len(starts)).mean(axis=1)
         reached = result.reached.reshape(len(specs), len(starts)).sum(axis=1)
         for (_, genome), f in zip(genomes, fitness, strict=True):
@@ -291,6 +289,7 @@ def evolve(
     checkpoint_every: int = 10,
     progress: Callable[[GenerationStats, EvolutionSettings], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
+    workers: int | None = None,
 ) -> EvolutionResult:
     """Run NEAT on the maze task to the last generation.
 
@@ -302,25 +301,30 @@ def evolve(
         progress: called after every generation.
         should_stop: polled after every generation; True saves and raises
             :class:`~offline_evolution.repertoire.map_elites.Interrupted`.
+        workers: processes that run episodes (PyBullet robots; default: every core). The
+            result does not depend on it.
     """
-    run = Evolution(settings, repertoire)
-    elapsed = 0.0
-    if checkpoint is not None and os.path.exists(checkpoint):
-        elapsed = run.restore(checkpoint)
-    start = time.perf_counter() - elapsed
-    while not run.finished:
-        stats = run.step()
-        if progress is not None:
-            progress(stats, settings)
-        stop = should_stop is not None and should_stop() and not run.finished
-        due = checkpoint is not None and run.generation % max(1, checkpoint_every) == 0
-        if checkpoint is not None and (due or stop) and not run.finished:
-            run.save(checkpoint, time.perf_counter() - start)
-        if stop:
-            raise Interrupted(run.generation, None if checkpoint is None else str(checkpoint))
-    if checkpoint is not None and os.path.exists(checkpoint):
-        os.remove(checkpoint)
-    return run.result(time.perf_counter() - start)
+    run = Evolution(settings, repertoire, workers)
+    try:
+        elapsed = 0.0
+        if checkpoint is not None and os.path.exists(checkpoint):
+            elapsed = run.restore(checkpoint)
+        start = time.perf_counter() - elapsed
+        while not run.finished:
+            stats = run.step()
+            if progress is not None:
+                progress(stats, settings)
+            stop = should_stop is not None and should_stop() and not run.finished
+            due = checkpoint is not None and run.generation % max(1, checkpoint_every) == 0
+            if checkpoint is not None and (due or stop) and not run.finished:
+                run.save(checkpoint, time.perf_counter() - start)
+            if stop:
+                raise Interrupted(run.generation, None if checkpoint is None else str(checkpoint))
+        if checkpoint is not None and os.path.exists(checkpoint):
+            os.remove(checkpoint)
+        return run.result(time.perf_counter() - start)
+    finally:
+        run.task.close()
 
 
 def arbitrator_file(
@@ -370,7 +374,7 @@ def arbitrator_file(
         robot=s.robot,
         network=result.selected_network,
         sensors=task.layout,
-        parameters=task.robot.parameter_specs,
+        parameters=task.parameter_specs,
         control_period=task.dt,
         evolution=evolution,
     )

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from offline_evolution.arbitrator.compiled import pack_networks
 from offline_evolution.maze_task.task import ControllerArrays, MazeTask
 
 #: Seed stream of the post-evaluation starts, apart from every generation's.
@@ -102,7 +101,7 @@ def post_evaluate(
 
     Ties go to the earlier candidate (the hall lists the highest training fitness first).
     """
-    result = task.run(pack_networks(networks), controller, np.arange(len(networks)), starts)
+    result = task.evaluate(networks, controller, starts)
     n = len(starts)
     fitness = result.fitness.reshape(len(networks), n).mean(axis=1)
     reached = result.reached.reshape(len(networks), n).mean(axis=1)

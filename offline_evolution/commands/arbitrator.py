@@ -12,6 +12,7 @@ from offline_evolution.commands.common import (
     EXIT_INTERRUPTED,
     CliError,
     StopOnSignal,
+    add_workers_option,
     check_writable,
     count,
     default_checkpoint,
@@ -52,6 +53,7 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         help="discard an existing checkpoint and start from scratch",
     )
     p.add_argument("--quiet", action="store_true", help="no per-generation lines")
+    add_workers_option(p)
 
 
 def add_parsers(sub) -> None:
@@ -80,7 +82,8 @@ def add_parsers(sub) -> None:
     std.add_argument(
         "--equal-budget",
         action="store_true",
-        help="add the generations that match EvoRBC's repertoire budget (+25 for the 4WS robots)",
+        help="add the generations that match EvoRBC's repertoire budget (+25 for the 4WS "
+        "robots, +455 for the hexapod)",
     )
     _common_options(std)
     std.set_defaults(func=cmd_evolve, kind="standard")
@@ -117,7 +120,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         file_sha256,
     )
     from offline_evolution.arbitrator.settings import load_run_settings
-    from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
+    from offline_evolution.maze_task.task import MazeTaskSettings, make_task
 
     repertoire = None
     if args.kind == "evorbc":
@@ -165,6 +168,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             checkpoint_every=every,
             progress=_GenerationPrinter(args.quiet, generations),
             should_stop=stop,
+            workers=args.workers or None,
         )
     except CheckpointError as e:
         raise CliError(f"{e}; use --restart to discard it") from None
@@ -176,8 +180,11 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         ) from None
     finally:
         stop.restore(previous)
-    task = MazeTask(task_settings, robot)
-    arbitrator_file(result, task, repertoire, args.repertoire if repertoire else None).save(out)
+    task = make_task(task_settings, robot, workers=1)
+    try:
+        arbitrator_file(result, task, repertoire, args.repertoire if repertoire else None).save(out)
+    finally:
+        task.close()
     from offline_evolution.plots.fitness import plot_fitness_history
 
     plot_fitness_history(

@@ -76,6 +76,17 @@ class StopOnSignal:
             signal.signal(sig, old)
 
 
+def add_workers_option(parser: argparse.ArgumentParser) -> None:
+    """``--workers N``: processes for PyBullet simulations (results do not depend on it)."""
+    parser.add_argument(
+        "--workers",
+        type=count,
+        metavar="N",
+        help="worker processes for robots simulated in PyBullet (default: one per core); "
+        "results are the same for any number",
+    )
+
+
 def check_writable(*paths) -> None:
     """Fail early (before a long run) if an output folder cannot be created or written."""
     for p in paths:

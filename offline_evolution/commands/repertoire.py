@@ -14,6 +14,7 @@ from offline_evolution.commands.common import (
     EXIT_USAGE,
     CliError,
     StopOnSignal,
+    add_workers_option,
     check_writable,
     count,
     default_checkpoint,
@@ -77,6 +78,7 @@ def add_parsers(sub) -> None:
         help="discard an existing checkpoint and start from scratch",
     )
     rep.add_argument("--quiet", action="store_true", help="no progress lines")
+    add_workers_option(rep)
     rep.set_defaults(func=cmd_repertoire)
 
     csv = sub.add_parser("export-csv", help="convert a repertoire file to CSV")
@@ -104,11 +106,13 @@ class _ProgressPrinter:
         if now - self.last < self.interval and p.iteration < p.iterations:
             return
         self.last = now
-        rate = p.evaluations / p.elapsed if p.elapsed > 0 else 0.0
+        rate = p.rate
+        speed = f"{rate / 1e3:7.0f}k eval/s" if rate >= 1e4 else f"{rate:7.1f} eval/s"
+        eta = f"  eta {p.eta / 60:6.1f} min" if rate < 1e4 and p.eta != float("inf") else ""
         print(
             f"iteration {p.iteration:>5}/{p.iterations}  evaluations {p.evaluations:>9,}  "
             f"primitives {p.cells:>5}  mean quality {p.mean_quality:.3f}  "
-            f"QD-score {p.qd_score:8.1f}  {rate / 1e3:7.0f}k eval/s",
+            f"QD-score {p.qd_score:8.1f}  {speed}{eta}",
             file=sys.stderr,
         )
 
@@ -146,6 +150,7 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
             checkpoint_every=args.checkpoint_every,
             progress=_ProgressPrinter(args.quiet),
             should_stop=stop,
+            workers=args.workers or None,
         )
     except CheckpointError as e:
         raise CliError(f"{e}; use --restart to discard it") from None

@@ -96,7 +96,7 @@ def resolve_repertoire(
 def cmd_replay(args: argparse.Namespace) -> int:
     """Replay and report; optionally draw trajectories and the selection heatmap."""
     from offline_evolution.maze_task.replay import replay
-    from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
+    from offline_evolution.maze_task.task import MazeTaskSettings, make_task
 
     arb_path = Path(args.arbitrator)
     arb = ArbitratorFile.load(arb_path)
@@ -113,20 +113,24 @@ def cmd_replay(args: argparse.Namespace) -> int:
     elif recorded:
         settings = build_settings(MazeTaskSettings, recorded, f"{arb_path}: evolution.task")
     else:
-        settings = MazeTaskSettings.load(config_dir() / "tasks" / "maze-4ws.yaml")
+        family = "hexapod" if arb.robot == "hexapod" else "4ws"
+        settings = MazeTaskSettings.load(config_dir() / "tasks" / f"maze-{family}.yaml")
     if args.maze != "all":
         settings = MazeTaskSettings((args.maze,), settings.episode_time, 1, settings.sensors)
-    task = MazeTask(settings, arb.robot)
+    task = make_task(settings, arb.robot)
     try:
-        arb.check_sensors(task.layout, settings.sensors, args.allow_mismatch)
-    except ArbitratorError as e:
-        raise CliError(str(e)) from None
-    if args.start == "random":
-        starts = task.sample_starts(np.random.default_rng(args.seed))
-    else:
-        starts = task.nominal_starts()
-    check_writable(args.plot, args.heatmap)
-    outcomes, result = replay(arb, task, starts, repertoire)
+        try:
+            arb.check_sensors(task.layout, settings.sensors, args.allow_mismatch)
+        except ArbitratorError as e:
+            raise CliError(str(e)) from None
+        if args.start == "random":
+            starts = task.sample_starts(np.random.default_rng(args.seed))
+        else:
+            starts = task.nominal_starts()
+        check_writable(args.plot, args.heatmap)
+        outcomes, result = replay(arb, task, starts, repertoire)
+    finally:
+        task.close()
     mean = float(np.mean([o.fitness for o in outcomes]))
     reached = sum(o.reached for o in outcomes)
     if args.json:

@@ -8,13 +8,7 @@ import numpy as np
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.arbitrator.compiled import pack_networks
-from offline_evolution.maze_task.task import (
-    EpisodeResult,
-    MazeTask,
-    evorbc_controller,
-    standard_controller,
-)
+from offline_evolution.maze_task.task import EpisodeResult, MazeTask
 
 
 @dataclass(frozen=True)
@@ -49,13 +43,8 @@ def replay(
     repertoire: Repertoire | None = None,
 ) -> tuple[list[MazeOutcome], EpisodeResult]:
     """Run ``arbitrator`` from each ``starts`` row ``(maze, x, y, heading)``, recording."""
-    if arbitrator.kind == "evorbc":
-        controller = evorbc_controller(repertoire, arbitrator.mapping, task.robot)
-    else:
-        controller = standard_controller(task.robot)
-    result = task.run(
-        pack_networks([arbitrator.network]), controller, np.array([0]), starts, record=True
-    )
+    controller = task.controller(arbitrator.kind, repertoire, arbitrator.mapping)
+    result = task.evaluate([arbitrator.network], controller, starts, record=True)
     outcomes = []
     for e, row in enumerate(starts):
         n = int(result.cycles[e])

@@ -22,7 +22,7 @@ from evorbc_ros.config import build_settings, config_dir, load_yaml_mapping, set
 from evorbc_ros.mapping import MappingFunction, PrimitiveLookup
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.sensors import SensorLayout
-from offline_evolution.arbitrator.compiled import NetworkPack
+from offline_evolution.arbitrator.compiled import NetworkPack, pack_networks
 from offline_evolution.maze_task.kernel import EVORBC, STANDARD, run_episodes
 from offline_evolution.maze_task.world import pack_mazes
 from sim_bridge.maze import load_named_maze
@@ -122,6 +122,14 @@ class EpisodeResult(NamedTuple):
     pose: np.ndarray | None = None  # (E, n_cycles + 1, 3) x, y, heading per cycle
     choice: np.ndarray | None = None  # (E, n_cycles) primitive index (-1: standard)
     outputs: np.ndarray | None = None  # (E, n_cycles, n_outputs) network outputs
+    fell: np.ndarray | None = None  # bool, the robot fell over (legged robots only)
+
+
+def eq5_fitness(reached, seconds, final, initial, episode_time: float) -> np.ndarray:
+    """Eq. 5 per episode: ``2 - t/T`` if reached after ``t`` s, else ``1 - d_f / d_i``."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        missed = np.where(initial > 0, 1.0 - final / initial, 0.0)
+    return np.where(reached, 2.0 - np.asarray(seconds) / episode_time, missed)
 
 
 class MazeTask:
@@ -208,15 +216,56 @@ class MazeTask:
 
     def fitness(self, reached, cycles, final, initial) -> np.ndarray:
         """Eq. 5 for each episode."""
-        t = cycles * self.dt
-        with np.errstate(divide="ignore", invalid="ignore"):
-            missed = np.where(initial > 0, 1.0 - final / initial, 0.0)
-        return np.where(reached, 2.0 - t / self.settings.episode_time, missed)
+        return eq5_fitness(reached, cycles * self.dt, final, initial, self.settings.episode_time)
 
-    def mean_fitness(
-        self, networks: NetworkPack, controller: ControllerArrays, starts: np.ndarray
-    ) -> np.ndarray:
-        """Each network's fitness: the mean of eq. 5 over the episodes from ``starts``."""
-        n = len(networks.n_slots)
-        result = self.run(networks, controller, np.arange(n), starts)
-        return result.fitness.reshape(n, len(starts)).mean(axis=1)
+    # -- the interface shared with the hexapod's task ------------------------------
+
+    robot_name = property(lambda self: self.robot.name)
+
+    @property
+    def parameter_specs(self) -> tuple:
+        """The robot's locomotion parameters (a standard controller's outputs)."""
+        return self.robot.parameter_specs
+
+    @property
+    def n_standard_outputs(self) -> int:
+        """Outputs of a standard-NEAT network: one per locomotion parameter."""
+        return self.robot.type.n_parameters
+
+    def controller(
+        self, kind: str, repertoire: Repertoire | None = None, mapping: str | None = None
+    ) -> ControllerArrays:
+        """An EvoRBC controller (repertoire and mapping) or a standard one."""
+        if kind == "evorbc":
+            return evorbc_controller(repertoire, mapping, self.robot)
+        return standard_controller(self.robot)
+
+    def evaluate(
+        self,
+        networks: list,
+        controller: ControllerArrays,
+        starts: np.ndarray,
+        record: bool = False,
+    ) -> EpisodeResult:
+        """Every network (:class:`~evorbc_ros.network.NetworkSpec`) from every start row.
+
+        Episode ``i * len(starts) + j`` is network ``i`` from start ``j``.
+        """
+        pack = pack_networks(networks)
+        return self.run(pack, controller, np.arange(len(networks)), starts, record)
+
+    def close(self) -> None:
+        """Nothing to release: the kernel runs in this process."""
+
+
+def make_task(settings: MazeTaskSettings, robot: str, workers: int | None = None):
+    """The maze task for ``robot``: :class:`MazeTask` (4WS) or the hexapod's.
+
+    Args:
+        workers: processes that run episodes (PyBullet robots; default: every core).
+    """
+    if robot == "hexapod":
+        from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
+
+        return HexapodMazeTask(settings, workers=workers)
+    return MazeTask(settings, robot)

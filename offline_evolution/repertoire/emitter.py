@@ -5,6 +5,11 @@ uniformly from the gene range; every later batch holds ``batch_size`` mutants, e
 elite chosen uniformly at random, whose genes each mutate with probability
 ``mutation_probability`` by N(0, ``sigma``) and are clipped to [-1, 1].
 
+The initial batch is handed out in pieces of at most ``batch_size`` so that slow robots
+report progress and checkpoint during it. The pieces are the same draws from the same
+generator as one big batch, and adding them to the archive one after another keeps the
+same elites (a cell only takes a strictly better solution).
+
 Parents are drawn from the elites ordered by cell, with the emitter's own generator, so a
 run restored from a checkpoint (whose archive was refilled in a different order) draws
 exactly the same parents as an uninterrupted one.
@@ -44,16 +49,17 @@ class PaperMutationEmitter(EmitterBase):
         self.mutation_probability = mutation_probability
         self.sigma = sigma
         self.rng = np.random.default_rng(seed)
-        self.initialised = False
+        self.initial_remaining = initial_batch  # random solutions still to hand out
 
     def ask(self) -> np.ndarray:
         """The next batch of genes, ``(n, solution_dim)`` in [-1, 1]."""
         d = self.solution_dim
-        if not self.initialised or self.archive.empty:
-            # Also restart from random solutions if nothing survived (e.g. every legged
-            # primitive fell over), rather than mutating from an empty archive.
-            self.initialised = True
-            return self.rng.uniform(GENE_LOW, GENE_HIGH, size=(self.initial_batch, d))
+        if self.initial_remaining > 0 or self.archive.empty:
+            # An empty archive after the initial batch (e.g. every legged primitive fell
+            # over) gets more random solutions rather than mutants of nothing.
+            n = min(self.batch_size, self.initial_remaining) or self.batch_size
+            self.initial_remaining = max(0, self.initial_remaining - n)
+            return self.rng.uniform(GENE_LOW, GENE_HIGH, size=(n, d))
         parents = elites_by_cell(self.archive)["solution"]
         chosen = parents[self.rng.integers(len(parents), size=self.batch_size)]
         mutate = self.rng.random((self.batch_size, d)) < self.mutation_probability
@@ -62,9 +68,9 @@ class PaperMutationEmitter(EmitterBase):
 
     def get_state(self) -> dict:
         """Plain-data state for checkpoints (JSON-safe)."""
-        return {"rng": self.rng.bit_generator.state, "initialised": self.initialised}
+        return {"rng": self.rng.bit_generator.state, "initial_remaining": self.initial_remaining}
 
     def set_state(self, state: dict) -> None:
         """Restore what :meth:`get_state` returned."""
         self.rng.bit_generator.state = state["rng"]
-        self.initialised = bool(state["initialised"])
+        self.initial_remaining = int(state["initial_remaining"])

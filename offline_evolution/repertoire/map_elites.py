@@ -52,14 +52,33 @@ class Progress:
     qd_score: float
     elapsed: float  # s of wall time in this process
     resumed_from: int | None = None  # iteration the run resumed from, if any
+    total_evaluations: int = 0  # evaluations of the whole run
+    evaluations_at_start: int = 0  # evaluations already done when this process started
+
+    @property
+    def rate(self) -> float:
+        """Evaluations per second in this process."""
+        done = self.evaluations - self.evaluations_at_start
+        return done / self.elapsed if self.elapsed > 0 else 0.0
+
+    @property
+    def eta(self) -> float:
+        """Seconds of wall time left at the current rate (inf before any rate is known)."""
+        rate = self.rate
+        return (self.total_evaluations - self.evaluations) / rate if rate > 0 else float("inf")
 
 
 class MapElites:
     """One MAP-Elites run: archive, emitter and the iteration counter."""
 
-    def __init__(self, settings: MapElitesSettings, robot: SimulatedRobot | None = None):
+    def __init__(
+        self,
+        settings: MapElitesSettings,
+        robot: SimulatedRobot | None = None,
+        workers: int | None = None,
+    ):
         self.settings = settings
-        self.robot = robot or make_robot(settings.robot)
+        self.robot = robot or make_robot(settings.robot, workers=workers)
         try:
             control_steps(settings.eval_time, self.robot.control_period)
         except ValueError as e:
@@ -76,35 +95,53 @@ class MapElites:
             sigma=settings.mutation_sigma,
             seed=settings.seed,
         )
-        self.batches_done = 0  # the initial batch counts as batch 1
+        self.batches_done = 0  # pieces of the initial batch count as batches
         self.evaluations = 0
+        self.discarded = 0  # primitives not added: quality NaN (fell over) or out of bounds
 
     @property
     def iteration(self) -> int:
-        """Iterations completed after the initial batch."""
-        return max(0, self.batches_done - 1)
+        """Iterations (mutant batches) completed after the initial batch."""
+        return max(0, self.evaluations - self.settings.initial_batch) // self.settings.batch_size
 
     @property
     def finished(self) -> bool:
         """True once the initial batch and every iteration have run."""
-        return self.batches_done >= 1 + self.settings.iterations
+        return self.evaluations >= self.settings.evaluations
 
     def step(self) -> None:
-        """Run one batch: ask, evaluate, score, add."""
+        """Run one batch: ask, evaluate, then :meth:`tell`."""
         genes = self.emitter.ask()
-        outcome = self.robot.evaluate_primitives(genes, self.settings.eval_time)
+        self.tell(genes, self.robot.evaluate_primitives(genes, self.settings.eval_time))
+
+    def tell(self, genes: np.ndarray, outcome) -> None:
+        """Score a batch's outcome and add the primitives that count to the archive."""
         quality = self.metric(outcome)
-        keep = np.isfinite(quality)  # NaN: discarded (e.g. a legged robot fell over)
+        behaviour = outcome.displacement
+        low, high = np.asarray(self.layout["low"]), np.asarray(self.layout["high"])
+        # NaN quality: discarded by the metric (a legged robot fell over). A behaviour
+        # outside the archive would be clipped into an edge cell: drop it instead.
+        inside = np.all((behaviour >= low) & (behaviour < high), axis=1)
+        keep = np.isfinite(quality) & inside
         self.archive.add(
             genes[keep],
             quality[keep],
-            outcome.displacement[keep],
+            behaviour[keep],
             heading=outcome.heading[keep],
         )
         self.batches_done += 1
         self.evaluations += len(genes)
+        self.discarded += int(np.sum(~keep))
 
-    def progress(self, elapsed: float, resumed_from: int | None = None) -> Progress:
+    def close(self) -> None:
+        """Release the robot's resources (worker processes of a PyBullet robot)."""
+        close = getattr(self.robot, "close", None)
+        if close is not None:
+            close()
+
+    def progress(
+        self, elapsed: float, resumed_from: int | None = None, evaluations_at_start: int = 0
+    ) -> Progress:
         """Current figures of the run."""
         q = self.archive.data("objective")
         return Progress(
@@ -116,6 +153,8 @@ class MapElites:
             qd_score=float(q.sum()),
             elapsed=elapsed,
             resumed_from=resumed_from,
+            total_evaluations=self.settings.evaluations,
+            evaluations_at_start=evaluations_at_start,
         )
 
     def repertoire(self) -> Repertoire:
@@ -143,9 +182,15 @@ class MapElites:
                 "mutation_sigma": s.mutation_sigma,
                 "variation": s.variation,
                 "evaluations": self.evaluations,
+                "discarded": self.discarded,
                 "library": f"pyribs {ribs.__version__}",
+                **self._simulation(),
             },
         )
+
+    def _simulation(self) -> dict:
+        describe = getattr(self.robot, "describe", None)
+        return {"simulation": describe()} if describe is not None else {}
 
     # -- checkpoints -------------------------------------------------------------------
 
@@ -157,6 +202,7 @@ class MapElites:
             "settings": self.settings.as_dict(),
             "batches_done": self.batches_done,
             "evaluations": self.evaluations,
+            "discarded": self.discarded,
             "emitter": self.emitter.get_state(),
         }
         arrays = {k: elites[k] for k in ("solution", "objective", "measures", *EXTRA_FIELDS)}
@@ -187,6 +233,7 @@ class MapElites:
             self.emitter.set_state(header["emitter"])
             self.batches_done = int(header["batches_done"])
             self.evaluations = int(header["evaluations"])
+            self.discarded = int(header["discarded"])
         except (KeyError, ValueError, TypeError) as e:
             raise CheckpointError(f"{path}: not a usable checkpoint ({e})") from None
 
@@ -197,8 +244,10 @@ def generate_repertoire(
     robot: SimulatedRobot | None = None,
     checkpoint: str | os.PathLike | None = None,
     checkpoint_every: int = 100,
+    checkpoint_seconds: float = 300.0,
     progress: Callable[[Progress], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
+    workers: int | None = None,
 ) -> Repertoire:
     """Run MAP-Elites to the end and return the repertoire.
 
@@ -206,35 +255,47 @@ def generate_repertoire(
         settings: the run's settings (Table I defaults come from ``config/``).
         robot: the simulated robot; by default the one ``settings.robot`` names.
         checkpoint: file to resume from if it exists, and to save to every
-            ``checkpoint_every`` iterations; removed once the run finishes.
+            ``checkpoint_every`` batches or ``checkpoint_seconds`` of wall time,
+            whichever comes first; removed once the run finishes.
         progress: called after every batch with a :class:`Progress`.
         should_stop: polled after every batch; if it returns True the run saves its
             checkpoint and raises :class:`Interrupted`.
+        workers: processes that evaluate primitives (PyBullet robots; default: every
+            core). The result does not depend on it.
 
     Raises:
         CheckpointError: the checkpoint exists but belongs to another run or is corrupt.
         Interrupted: ``should_stop`` asked to stop.
 
     """
-    run = MapElites(settings, robot)
-    resumed_from = None
-    if checkpoint is not None and os.path.exists(checkpoint):
-        run.restore(checkpoint)
-        resumed_from = run.iteration
-    start = time.perf_counter()
-    while not run.finished:
-        run.step()
-        if progress is not None:
-            progress(run.progress(time.perf_counter() - start, resumed_from))
-        due = checkpoint is not None and run.batches_done % max(1, checkpoint_every) == 0
-        stop = should_stop is not None and should_stop() and not run.finished
-        if due or (stop and checkpoint is not None):
-            run.save(checkpoint)
-        if stop:
-            raise Interrupted(run.iteration, None if checkpoint is None else str(checkpoint))
-    if checkpoint is not None and os.path.exists(checkpoint):
-        os.remove(checkpoint)
-    return run.repertoire()
+    run = MapElites(settings, robot, workers=workers)
+    try:
+        resumed_from = None
+        if checkpoint is not None and os.path.exists(checkpoint):
+            run.restore(checkpoint)
+            resumed_from = run.iteration
+        at_start = run.evaluations
+        start = last_save = time.perf_counter()
+        while not run.finished:
+            run.step()
+            now = time.perf_counter()
+            if progress is not None:
+                progress(run.progress(now - start, resumed_from, at_start))
+            due = checkpoint is not None and (
+                run.batches_done % max(1, checkpoint_every) == 0
+                or now - last_save >= checkpoint_seconds
+            )
+            stop = should_stop is not None and should_stop() and not run.finished
+            if checkpoint is not None and (due or stop) and not run.finished:
+                run.save(checkpoint)
+                last_save = now
+            if stop:
+                raise Interrupted(run.iteration, None if checkpoint is None else str(checkpoint))
+        if checkpoint is not None and os.path.exists(checkpoint):
+            os.remove(checkpoint)
+        return run.repertoire()
+    finally:
+        run.close()
 
 
 __all__ = ["Interrupted", "MapElites", "Progress", "generate_repertoire"]

@@ -1,0 +1,183 @@
+"""One hexapod maze episode in PyBullet, with the onboard controller code (worker side).
+
+Each control cycle (0.1 s): scan the laser and read the pose, turn them into inputs with
+the laser and radar nodes' own code (:class:`~evorbc_ros.laser.LaserToRangefinders`,
+:class:`~evorbc_ros.goal.GoalInputs`), activate the network
+(:class:`~evorbc_ros.network.CompiledNetwork`), pick the primitive (EvoRBC: mapping and
+nearest-primitive lookup; standard NEAT: the outputs are the 37 genes), and run the
+physics for one period with the joint targets of eq. 10 at every physics step (time since
+the episode began). The episode ends at the target, when the body has fallen over, or at
+the time limit.
+
+The ROS graph computes the same numbers from the same messages, so a lockstep run
+reproduces an episode cycle by cycle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from evorbc_ros.goal import GoalInputs, yaw_from_quaternion
+from evorbc_ros.laser import LaserToRangefinders
+from evorbc_ros.mapping import MappingFunction, PrimitiveLookup
+from evorbc_ros.network import NetworkSpec
+from evorbc_ros.robots.hexapod import GaitTable, HexapodGeometry
+from evorbc_ros.sensors import SensorLayout
+from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings
+from sim_bridge.hexapod.scanner import Scanner
+from sim_bridge.maze import Maze
+
+#: Body tilt (rad) at which a hexapod has fallen over: the episode ends there.
+FALLEN_TILT = math.radians(90.0)
+
+
+@dataclass(frozen=True)
+class HexapodController:
+    """How network outputs become a primitive (picklable, sent to the workers)."""
+
+    kind: str  # "evorbc" or "standard"
+    mapping: str | None = None
+    genes: np.ndarray | None = None  # (n, 37) repertoire genes (EvoRBC)
+    behaviour: np.ndarray | None = None  # (n, 2) m, repertoire behaviours (EvoRBC)
+    key: str = ""  # identifies the controller, so workers build its lookup grid once
+
+
+@dataclass(frozen=True)
+class HexapodWorld:
+    """Everything an episode needs besides the controller (picklable)."""
+
+    mazes: tuple[Maze, ...]
+    layout: SensorLayout
+    geometry: HexapodGeometry
+    physics: PhysicsSettings
+    n_cycles: int
+
+    def scanner(self) -> Scanner:
+        """The laser scanner whose beams are the layout's rays."""
+        return Scanner.from_layout(self.layout.rangefinders)
+
+
+class _Chooser:
+    """Network outputs -> genes, as the arbitrator or a standard controller does."""
+
+    def __init__(self, controller: HexapodController, geometry: HexapodGeometry):
+        self.kind = controller.kind
+        if self.kind == "evorbc":
+            self.genes = np.asarray(controller.genes, dtype=np.float64)
+            self.table = GaitTable(self.genes, geometry)
+            self.mapping = MappingFunction.for_behaviours(controller.mapping, controller.behaviour)
+            self.lookup = PrimitiveLookup.build(controller.behaviour, self.mapping.domain())
+        self.geometry = geometry
+
+    def choose(self, out: np.ndarray) -> tuple[int, GaitTable, np.ndarray]:
+        """``(primitive index or -1, gait table, row)`` for one activation."""
+        if self.kind == "evorbc":
+            x, y = self.mapping.point(out[0], out[1])
+            index = self.lookup.nearest(x, y)
+            return index, self.table, np.array([index])
+        genes = 2.0 * np.clip(out, 0.0, 1.0) - 1.0
+        return -1, GaitTable(genes, self.geometry), np.array([0])
+
+
+class EpisodeRunner:
+    """Runs episodes in per-maze simulations kept alive between calls."""
+
+    def __init__(self, world: HexapodWorld):
+        self.world = world
+        self.scanner = world.scanner()
+        self.laser = LaserToRangefinders(world.layout.rangefinders)
+        self.goal = GoalInputs(world.layout)
+        self.sims: dict[int, HexapodSim] = {}
+        self.choosers: dict[str, _Chooser] = {}
+        self.per_period = world.physics.steps(world.geometry.control_period)
+
+    def chooser(self, controller: HexapodController) -> _Chooser:
+        """The chooser of ``controller`` (built once per controller key)."""
+        if controller.key not in self.choosers:
+            self.choosers = {controller.key: _Chooser(controller, self.world.geometry)}
+        return self.choosers[controller.key]
+
+    def sim(self, maze: int) -> HexapodSim:
+        """The simulation of maze ``maze`` (built on first use)."""
+        if maze not in self.sims:
+            w = self.world
+            self.sims[maze] = HexapodSim(w.geometry, w.physics, w.mazes[maze].boxes)
+        return self.sims[maze]
+
+    def inputs(self, sim: HexapodSim, maze: Maze) -> np.ndarray:
+        """The arbitrator's inputs now: laser groups, then goal bearing."""
+        s = self.scanner
+        ranges = s.scan(sim)
+        rf = self.laser.readings(s.angle_min, s.angle_increment, ranges, s.range_min, s.range_max)
+        (x, y, _), orn, _, _ = sim.base_state()
+        yaw = yaw_from_quaternion(*orn)
+        goal = self.goal.readings(x, y, yaw, maze.target[0], maze.target[1])
+        return np.concatenate([rf, goal])
+
+    def run(
+        self,
+        network: NetworkSpec,
+        controller: HexapodController,
+        maze_index: int,
+        start: tuple[float, float, float],
+        record: bool = False,
+    ) -> dict:
+        """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index``.
+
+        Returns:
+            ``{"reached", "fell", "cycles", "final_distance", "initial_distance"}`` and,
+            with ``record``, ``"pose" (cycles + 1, 3)``, ``"choice" (cycles,)`` and
+            ``"outputs" (cycles, n_outputs)``.
+
+        """
+        maze = self.world.mazes[maze_index]
+        sim = self.sim(maze_index)
+        sim.reset(*start)
+        net = network.compile()
+        chooser = self.chooser(controller)
+        tx, ty = maze.target
+        x, y, heading, _ = sim.pose()
+        initial = math.hypot(x - tx, y - ty)
+        distance = initial
+        reached = fell = False
+        poses, choices, outputs = [(x, y, heading)], [], []
+        cycles = self.world.n_cycles
+        for cycle in range(self.world.n_cycles):
+            out = net.activate(self.inputs(sim, maze))
+            index, table, row = chooser.choose(out)
+            times = sim.step_times(self.per_period)
+            targets = table.joint_targets(times, np.repeat(row, len(times)))
+            tilt, _ = sim.run(targets, max_tilt=FALLEN_TILT)
+            x, y, heading, _ = sim.pose()
+            distance = math.hypot(x - tx, y - ty)
+            if record:
+                poses.append((x, y, heading))
+                choices.append(index)
+                outputs.append(out)
+            if distance <= maze.target_radius:
+                reached, cycles = True, cycle + 1
+                break
+            if tilt > FALLEN_TILT:
+                fell = True  # cycles stays n_cycles: eq. 5 scores where it lies
+                break
+        result = {
+            "reached": reached,
+            "fell": fell,
+            "cycles": cycles,
+            "final_distance": distance,
+            "initial_distance": initial,
+        }
+        if record:
+            result["pose"] = np.array(poses)
+            result["choice"] = np.array(choices, dtype=np.int64)
+            result["outputs"] = np.array(outputs).reshape(len(choices), -1)
+        return result
+
+    def close(self) -> None:
+        """Disconnect every simulation."""
+        for sim in self.sims.values():
+            sim.close()
+        self.sims.clear()

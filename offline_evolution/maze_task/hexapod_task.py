@@ -1,0 +1,166 @@
+"""The maze task for the hexapod: episodes in PyBullet on worker processes (parent side).
+
+The interface is :class:`~offline_evolution.maze_task.task.MazeTask`'s: start poses,
+``evaluate`` (networks x starts -> :class:`EpisodeResult`) and eq. 5 fitness. Episodes
+are independent and start from a restored rest state, so results do not depend on the
+number of workers or on which worker ran an episode.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from evorbc_ros.config import config_dir
+from evorbc_ros.network import NetworkSpec
+from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.robots.hexapod import HEXAPOD, N_PARAMETERS, HexapodGeometry, parameter_specs
+from evorbc_ros.robots.primitive import ParameterSpec
+from evorbc_ros.sensors import SensorLayout
+from offline_evolution.maze_task.hexapod_episode import (
+    EpisodeRunner,
+    HexapodController,
+    HexapodWorld,
+)
+from offline_evolution.maze_task.task import EpisodeResult, MazeTaskSettings, eq5_fitness
+from sim_bridge.hexapod.physics import PhysicsSettings
+from sim_bridge.hexapod.pool import SpawnedWorkers, available_cores, ignore_sigint
+from sim_bridge.maze import load_named_maze
+from sim_bridge.robots.base import control_steps
+
+#: Radius (m) of a circle around the body centre that holds the hexapod's feet in the
+#: neutral pose (front feet at about (0.22, 0.20) m): start poses keep it clear of walls.
+FOOTPRINT_RADIUS = 0.30
+
+_runner: EpisodeRunner | None = None
+
+
+def _init_worker(world: HexapodWorld) -> None:
+    global _runner
+    ignore_sigint()
+    _runner = EpisodeRunner(world)
+
+
+def _run(runner: EpisodeRunner, job) -> dict:
+    network, controller, maze, start, record = job
+    return runner.run(NetworkSpec.from_dict(network), controller, maze, start, record)
+
+
+def _episode(job) -> dict:
+    return _run(_runner, job)
+
+
+class HexapodMazeTask(SpawnedWorkers):
+    """The maze task for the hexapod (``config/tasks/maze-hexapod.yaml``)."""
+
+    robot_name = HEXAPOD
+
+    def __init__(
+        self,
+        settings: MazeTaskSettings,
+        workers: int | None = None,
+        geometry: HexapodGeometry | None = None,
+        physics: PhysicsSettings | None = None,
+    ):
+        self.settings = settings
+        self.geometry = geometry or HexapodGeometry()
+        self.physics = physics or PhysicsSettings()
+        self.mazes = [load_named_maze(name) for name in settings.mazes]
+        self.layout = SensorLayout.load(config_dir() / settings.sensors)
+        if self.layout.rangefinders is None:
+            raise ValueError(f"{settings.sensors}: the hexapod's laser needs rangefinders")
+        self.dt = self.geometry.control_period
+        self.n_cycles = control_steps(settings.episode_time, self.dt)
+        self.world = HexapodWorld(
+            tuple(self.mazes), self.layout, self.geometry, self.physics, self.n_cycles
+        )
+        self.workers = max(1, workers or available_cores())
+        self._executor = None
+        self._local: EpisodeRunner | None = None
+
+    @property
+    def n_mazes(self) -> int:
+        """Number of mazes."""
+        return len(self.mazes)
+
+    @property
+    def parameter_specs(self) -> tuple[ParameterSpec, ...]:
+        """The robot's locomotion parameters (a standard controller's outputs)."""
+        return parameter_specs()
+
+    @property
+    def n_standard_outputs(self) -> int:
+        """Outputs of a standard-NEAT network: one per locomotion parameter (37)."""
+        return N_PARAMETERS
+
+    def sample_starts(self, rng: np.random.Generator) -> np.ndarray:
+        """``(n_mazes * samples_per_maze, 4)`` rows ``(maze, x, y, heading)``."""
+        rows = []
+        for k, maze in enumerate(self.mazes):
+            poses = maze.sample_starts(rng, self.settings.samples_per_maze, FOOTPRINT_RADIUS)
+            rows += [(k, *p) for p in poses]
+        return np.array(rows, dtype=np.float64)
+
+    def nominal_starts(self) -> np.ndarray:
+        """One row ``(maze, x, y, heading)`` per maze at its nominal start pose."""
+        return np.array([(k, *m.start_pose) for k, m in enumerate(self.mazes)])
+
+    def controller(
+        self, kind: str, repertoire: Repertoire | None = None, mapping: str | None = None
+    ) -> HexapodController:
+        """An EvoRBC controller (repertoire and mapping) or a standard one."""
+        if kind == "evorbc":
+            key = f"evorbc:{mapping}:{repertoire.fingerprint()}"
+            return HexapodController("evorbc", mapping, repertoire.genes, repertoire.behaviour, key)
+        return HexapodController("standard", key="standard")
+
+    def evaluate(
+        self,
+        networks: list[NetworkSpec],
+        controller: HexapodController,
+        starts: np.ndarray,
+        record: bool = False,
+    ) -> EpisodeResult:
+        """Every network from every start row; episode ``i * len(starts) + j``."""
+        jobs = [
+            (net.to_dict(), controller, int(row[0]), tuple(map(float, row[1:4])), record)
+            for net in networks
+            for row in starts
+        ]
+        results = self._map(jobs)
+        reached = np.array([r["reached"] for r in results], dtype=bool)
+        cycles = np.array([r["cycles"] for r in results], dtype=np.int64)
+        final = np.array([r["final_distance"] for r in results])
+        initial = np.array([r["initial_distance"] for r in results])
+        fell = np.array([r["fell"] for r in results], dtype=bool)
+        fitness = self.fitness(reached, cycles, final, initial)
+        if not record:
+            return EpisodeResult(reached, cycles, final, initial, fitness, fell=fell)
+        pose, choice, outputs = _padded_traces(results, self.n_cycles)
+        return EpisodeResult(reached, cycles, final, initial, fitness, pose, choice, outputs, fell)
+
+    def fitness(self, reached, cycles, final, initial) -> np.ndarray:
+        """Eq. 5 for each episode."""
+        return eq5_fitness(reached, cycles * self.dt, final, initial, self.settings.episode_time)
+
+    def _map(self, jobs: list) -> list[dict]:
+        if self.workers == 1 or len(jobs) == 1:
+            if self._local is None:
+                self._local = EpisodeRunner(self.world)
+            return [_run(self._local, job) for job in jobs]
+        return list(self._pool(_init_worker, (self.world,)).map(_episode, jobs))
+
+
+def _padded_traces(results: list[dict], n_cycles: int):
+    """Per-episode traces padded like the 4WS kernel's (NaN poses, -2 choices)."""
+    n = len(results)
+    n_out = max((r["outputs"].shape[1] for r in results if r["outputs"].size), default=1)
+    pose = np.full((n, n_cycles + 1, 3), np.nan)
+    choice = np.full((n, n_cycles), -2, dtype=np.int64)
+    outputs = np.full((n, n_cycles, n_out), np.nan)
+    for e, r in enumerate(results):
+        k = len(r["choice"])
+        pose[e, : k + 1] = r["pose"]
+        choice[e, :k] = r["choice"]
+        if k:
+            outputs[e, :k] = r["outputs"]
+    return pose, choice, outputs

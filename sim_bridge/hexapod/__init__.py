@@ -1,0 +1,1 @@
+"""The hexapod in PyBullet: URDF, physics, primitive evaluation and worker pools."""
