@@ -84,7 +84,7 @@ def test_episodes_are_identical_on_one_or_two_workers(repertoire):
         finally:
             t.close()
     one, two = results
-    for a, b in zip(one, two):
+    for a, b in zip(one, two, strict=True):
         np.testing.assert_array_equal(a, b)
     assert one.pose.shape == (6, 21, 3) and one.choice.shape == (6, 20)
     np.testing.assert_allclose(one.pose[:, 0, :2], np.tile(starts[:, 1:3], (3, 1)), atol=0.02)
