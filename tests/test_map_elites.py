@@ -5,8 +5,8 @@ import pytest
 from conftest import small_settings
 
 from offline_evolution.checkpoint import CheckpointError
-from offline_evolution.repertoire.archive import grid_layout, make_archive
-from offline_evolution.repertoire.emitter import PaperMutationEmitter
+from offline_evolution.repertoire.archive import cvt_layout, grid_layout, make_archive
+from offline_evolution.repertoire.emitter import IsoLineDDEmitter, PaperMutationEmitter
 from offline_evolution.repertoire.map_elites import (
     Interrupted,
     MapElites,
@@ -181,3 +181,75 @@ def test_full_table_one_budget_gives_a_high_quality_4ws5_repertoire():
     x, y = r.behaviour.T
     assert abs(np.sum(y > 0) - np.sum(y < 0)) < 0.1 * len(r)
     assert abs(np.sum(x > 0) - np.sum(x < 0)) < 0.1 * len(r)
+
+
+def test_iso_line_dd_children_lie_near_the_line_through_two_elites():
+    archive = make_archive(grid_layout(0.4, 0.04), solution_dim=4, seed=0)
+    a, b = np.array([-0.5, 0.0, 0.2, 0.4]), np.array([0.5, 0.0, -0.2, 0.4])
+    archive.add(np.array([a, b]), np.ones(2), np.array([[0.1, 0.0], [-0.1, 0.0]]),
+                heading=np.zeros(2))  # fmt: skip
+    emitter = IsoLineDDEmitter(
+        archive, initial_batch=1, batch_size=20000, iso_sigma=0.02, line_sigma=0.2, seed=3
+    )
+    emitter.ask()  # the random first batch
+    children = emitter.ask()
+    # Each child is a parent plus N(0, 0.02) per gene plus N(0, 0.2) times the difference
+    # of two parents (zero when both are the same elite, half the time).
+    off_line = children[:, [1, 3]] - (0.0, 0.4)  # genes where a and b agree
+    assert np.std(off_line) == pytest.approx(0.02, rel=0.05)
+    along = children[:, 0]
+    assert np.all(np.abs(along) <= 1.0)
+    near_parent = np.minimum(np.abs(along - 0.5), np.abs(along + 0.5))
+    assert np.mean(near_parent < 0.06) == pytest.approx(0.5 + 0.5 * 0.23, abs=0.03)
+
+
+def test_cvt_archive_is_mirror_symmetric_with_as_many_cells_as_the_grid():
+    layout = cvt_layout(max_reach=0.4, bin_size=0.04, seed=2)
+    assert layout["cells"] == 21 * 21 - 1 and layout["low"] == grid_layout(0.4, 0.04)["low"]
+    centroids = np.array(layout["centroids"])
+    mirrored = centroids * (1.0, -1.0)
+    archive = make_archive(layout, solution_dim=1, seed=0)
+    points = np.random.default_rng(0).uniform(-0.42, 0.42, size=(2000, 2))
+    cells = archive.index_of(points)
+    mirror_cells = archive.index_of(points * (1.0, -1.0))
+    # the cell of a mirrored point is the mirror of the point's cell
+    np.testing.assert_allclose(centroids[mirror_cells], mirrored[cells], atol=1e-12)
+    assert layout == cvt_layout(max_reach=0.4, bin_size=0.04, seed=2)  # seeded
+
+
+@pytest.mark.parametrize(
+    "archive, variation", [("grid", "iso_line_dd"), ("cvt", "paper"), ("cvt", "iso_line_dd")]
+)
+def test_other_operators_and_archives_resume_exactly(tmp_path, archive, variation):
+    settings = small_settings(archive=archive, variation=variation, iterations=10)
+    whole = generate_repertoire(settings)
+    assert whole.archive["kind"] == archive and whole.algorithm["variation"] == variation
+    assert len(whole) > 50
+    ckpt = tmp_path / "run.checkpoint.npz"
+    polls = []
+    with pytest.raises(Interrupted):
+        generate_repertoire(
+            settings, checkpoint=ckpt, should_stop=lambda: polls.append(1) or len(polls) == 7
+        )
+    assert_same_repertoire(generate_repertoire(settings, checkpoint=ckpt), whole)
+
+
+def test_symmetry_counts_filled_cells_whose_mirror_cell_is_filled(small_repertoire):
+    import dataclasses
+
+    from offline_evolution.repertoire.stats import repertoire_stats
+
+    behaviour = np.array([[0.0, 0.0], [0.09, 0.2], [0.09, -0.2], [0.31, 0.12], [0.31, 0.13]])
+    rep = dataclasses.replace(
+        small_repertoire,
+        genes=small_repertoire.genes[:5],
+        behaviour=behaviour,
+        heading=np.zeros(5),
+        quality=np.array([1.0, 1.5, 1.5, 1.2, 1.0]),
+    )
+    s = repertoire_stats(rep, bin_size=0.04)
+    # cells (0, 0), (2, 5), (2, -5), (8, 3): 3 off the x axis, 2 of them mirrored
+    assert s["count"] == 5 and s["cells"] == 4
+    assert s["mirrored"] == pytest.approx(2 / 3)
+    assert (s["left"], s["right"]) == (3, 1)
+    assert s["qd_score"] == pytest.approx(6.2)

@@ -25,6 +25,7 @@ from offline_evolution.commands.common import (
 def add_parsers(sub) -> None:
     """Register ``repertoire`` and ``export-csv``."""
     from offline_evolution.quality import METRICS
+    from offline_evolution.repertoire.settings import ARCHIVES, VARIATIONS
     from sim_bridge.robots import ROBOT_NAMES
 
     rep = sub.add_parser(
@@ -56,6 +57,14 @@ def add_parsers(sub) -> None:
         "--iterations", type=count, metavar="N", help="iterations after the initial batch (I)"
     )
     rep.add_argument("--seed", type=count, metavar="N", help="random seed")
+    rep.add_argument(
+        "--archive", choices=ARCHIVES, help="grid (the paper's) or cvt (Voronoi cells)"
+    )
+    rep.add_argument(
+        "--variation",
+        choices=VARIATIONS,
+        help="paper (Gaussian mutation) or iso_line_dd (Iso+LineDD of two elites)",
+    )
     rep.add_argument("--config", metavar="FILE.yaml", help="settings file (YAML)")
     rep.add_argument("--out", required=True, metavar="FILE", help="repertoire file to write (JSON)")
     rep.add_argument("--plot", metavar="FILE.png", help="also draw the repertoire (Fig. 8 style)")
@@ -132,6 +141,8 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
         batch_size=args.batch_size,
         iterations=args.iterations,
         seed=args.seed,
+        archive=args.archive,
+        variation=args.variation,
     )
     if settings.initial_batch < 1 or settings.batch_size < 1:
         raise CliError("--initial-batch and --batch-size must be at least 1", EXIT_USAGE)

@@ -13,12 +13,18 @@ same elites (a cell only takes a strictly better solution).
 Parents are drawn from the elites ordered by cell, with the emitter's own generator, so a
 run restored from a checkpoint (whose archive was refilled in a different order) draws
 exactly the same parents as an uninterrupted one.
+
+:class:`IsoLineDDEmitter` replaces the mutation by Iso+LineDD (Vassiliades & Mouret 2018):
+a child is ``x_i + N(0, iso_sigma^2 I) + N(0, line_sigma^2) (x_j - x_i)`` for two elites
+``x_i, x_j``, so it moves along the direction that joins elites ("directional variation")
+and explores the elite hypervolume rather than the whole gene cube.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from ribs.emitters import EmitterBase
+from ribs.emitters.operators import IsoLineOperator
 
 from evorbc_ros.robots.primitive import GENE_HIGH, GENE_LOW
 from offline_evolution.repertoire.archive import elites_by_cell
@@ -60,8 +66,12 @@ class PaperMutationEmitter(EmitterBase):
             n = min(self.batch_size, self.initial_remaining) or self.batch_size
             self.initial_remaining = max(0, self.initial_remaining - n)
             return self.rng.uniform(GENE_LOW, GENE_HIGH, size=(n, d))
-        parents = elites_by_cell(self.archive)["solution"]
-        chosen = parents[self.rng.integers(len(parents), size=self.batch_size)]
+        return self.vary(elites_by_cell(self.archive)["solution"])
+
+    def vary(self, elites: np.ndarray) -> np.ndarray:
+        """``batch_size`` children of uniformly chosen ``elites`` (the paper's mutation)."""
+        d = self.solution_dim
+        chosen = elites[self.rng.integers(len(elites), size=self.batch_size)]
         mutate = self.rng.random((self.batch_size, d)) < self.mutation_probability
         noise = self.rng.normal(0.0, self.sigma, size=(self.batch_size, d))
         return np.clip(chosen + np.where(mutate, noise, 0.0), GENE_LOW, GENE_HIGH)
@@ -74,3 +84,22 @@ class PaperMutationEmitter(EmitterBase):
         """Restore what :meth:`get_state` returned."""
         self.rng.bit_generator.state = state["rng"]
         self.initial_remaining = int(state["initial_remaining"])
+
+
+class IsoLineDDEmitter(PaperMutationEmitter):
+    """The paper's random first batch, then Iso+LineDD children of pairs of elites."""
+
+    def __init__(self, archive, *, iso_sigma: float, line_sigma: float, **kwargs) -> None:
+        super().__init__(archive, mutation_probability=0.0, sigma=0.0, **kwargs)
+        self.iso_sigma = iso_sigma
+        self.line_sigma = line_sigma
+
+    def vary(self, elites: np.ndarray) -> np.ndarray:
+        """``batch_size`` Iso+LineDD children, clipped to the gene range."""
+        pairs = elites[self.rng.integers(len(elites), size=(2, self.batch_size))]
+        # pyribs' operator keeps its own generator; seeding it from ours each batch keeps
+        # the whole run reproducible from the emitter state alone (checkpoints).
+        operator = IsoLineOperator(
+            self.iso_sigma, self.line_sigma, seed=int(self.rng.integers(2**63))
+        )
+        return np.clip(operator.ask(pairs), GENE_LOW, GENE_HIGH)

@@ -28,11 +28,12 @@ from offline_evolution.checkpoint import (
 from offline_evolution.quality import quality_metric
 from offline_evolution.repertoire.archive import (
     EXTRA_FIELDS,
+    cvt_layout,
     elites_by_cell,
     grid_layout,
     make_archive,
 )
-from offline_evolution.repertoire.emitter import PaperMutationEmitter
+from offline_evolution.repertoire.emitter import IsoLineDDEmitter, PaperMutationEmitter
 from offline_evolution.repertoire.settings import MapElitesSettings
 from sim_bridge.robots import SimulatedRobot, make_robot
 from sim_bridge.robots.base import control_steps
@@ -84,17 +85,14 @@ class MapElites:
         except ValueError as e:
             raise ConfigError(f"eval_time of {self.robot.name}: {e}") from None
         self.metric = quality_metric(settings.metric)
-        self.layout = grid_layout(self.robot.max_reach(settings.eval_time), settings.bin_size)
+        reach = self.robot.max_reach(settings.eval_time)
+        if settings.archive == "cvt":
+            self.layout = cvt_layout(reach, settings.bin_size, settings.seed)
+        else:
+            self.layout = grid_layout(reach, settings.bin_size)
         d = len(self.robot.parameter_specs)
         self.archive = make_archive(self.layout, d, settings.seed)
-        self.emitter = PaperMutationEmitter(
-            self.archive,
-            initial_batch=settings.initial_batch,
-            batch_size=settings.batch_size,
-            mutation_probability=settings.mutation_probability,
-            sigma=settings.mutation_sigma,
-            seed=settings.seed,
-        )
+        self.emitter = make_emitter(self.archive, settings)
         self.batches_done = 0  # pieces of the initial batch count as batches
         self.evaluations = 0
         self.discarded = 0  # primitives not added: quality NaN (fell over) or out of bounds
@@ -181,6 +179,11 @@ class MapElites:
                 "mutation_probability": s.mutation_probability,
                 "mutation_sigma": s.mutation_sigma,
                 "variation": s.variation,
+                **(
+                    {"iso_sigma": s.iso_sigma, "line_sigma": s.line_sigma}
+                    if s.variation == "iso_line_dd"
+                    else {}
+                ),
                 "evaluations": self.evaluations,
                 "discarded": self.discarded,
                 "library": f"pyribs {ribs.__version__}",
@@ -206,6 +209,8 @@ class MapElites:
             "emitter": self.emitter.get_state(),
         }
         arrays = {k: elites[k] for k in ("solution", "objective", "measures", *EXTRA_FIELDS)}
+        if "centroids" in self.layout:
+            arrays["centroids"] = np.asarray(self.layout["centroids"])
         save_checkpoint(path, header, arrays)
 
     def restore(self, path: str | os.PathLike) -> None:
@@ -221,6 +226,12 @@ class MapElites:
         mismatch = settings_mismatch(header.get("settings", {}), self.settings.as_dict())
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
+        if "centroids" in self.layout and not np.array_equal(
+            arrays.get("centroids"), np.asarray(self.layout["centroids"])
+        ):
+            # k-means is seeded, but a different BLAS or scikit-learn could still move
+            # the centroids; elites filed under other cells would silently change the run.
+            raise CheckpointError(f"{path}: its CVT centroids differ from this run's")
         try:
             self.archive.clear()
             if len(arrays["objective"]):
@@ -236,6 +247,25 @@ class MapElites:
             self.discarded = int(header["discarded"])
         except (KeyError, ValueError, TypeError) as e:
             raise CheckpointError(f"{path}: not a usable checkpoint ({e})") from None
+
+
+def make_emitter(archive, settings: MapElitesSettings) -> PaperMutationEmitter:
+    """The emitter for ``settings.variation``: the paper's mutation or Iso+LineDD."""
+    common = {
+        "initial_batch": settings.initial_batch,
+        "batch_size": settings.batch_size,
+        "seed": settings.seed,
+    }
+    if settings.variation == "iso_line_dd":
+        return IsoLineDDEmitter(
+            archive, iso_sigma=settings.iso_sigma, line_sigma=settings.line_sigma, **common
+        )
+    return PaperMutationEmitter(
+        archive,
+        mutation_probability=settings.mutation_probability,
+        sigma=settings.mutation_sigma,
+        **common,
+    )
 
 
 def generate_repertoire(

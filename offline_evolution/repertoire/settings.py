@@ -15,8 +15,8 @@ from evorbc_ros.config import build_settings, config_dir, load_yaml_mapping, set
 from offline_evolution.quality import METRICS
 from sim_bridge.robots import ROBOT_NAMES
 
-ARCHIVES = ("grid",)
-VARIATIONS = ("paper",)
+ARCHIVES = ("grid", "cvt")
+VARIATIONS = ("paper", "iso_line_dd")
 
 
 @dataclass(frozen=True)
@@ -37,6 +37,10 @@ class MapElitesSettings:
     seed: int = setting(0, doc="seed of every random choice of the run", minimum=0)
     archive: str = setting("grid", doc="archive kind", choices=ARCHIVES)
     variation: str = setting("paper", doc="variation operator", choices=VARIATIONS)
+    iso_sigma: float = setting(0.02, doc="Iso+LineDD: sd of the isotropic gene noise", minimum=0.0)
+    line_sigma: float = setting(
+        0.2, doc="Iso+LineDD: sd of the step along the line between two elites", minimum=0.0
+    )
 
     @property
     def evaluations(self) -> int:
