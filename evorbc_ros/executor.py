@@ -31,23 +31,16 @@ class WheelCommand:
         return np.full(4, self.speed / wheel_radius)
 
 
-class PrimitiveExecutor:
-    """Holds the current primitive and the freshness of every input."""
+class InputWatch:
+    """The current primitive's genes and the freshness of every input (any robot)."""
 
-    def __init__(
-        self,
-        robot: FourWSType,
-        geometry: FourWSGeometry,
-        inputs: list[str],
-        stale_timeout: float = 0.3,
-    ):
-        self.robot = robot
-        self.geometry = geometry
+    def __init__(self, robot_name: str, n_parameters: int, inputs: list[str], stale_timeout):
+        self.robot_name = robot_name
+        self.n_parameters = n_parameters
         self.stale_timeout = stale_timeout
         self.last_seen: dict[str, float | None] = dict.fromkeys(["primitive", *inputs])
         self.first_event: float | None = None  # when the first input of any kind arrived
         self.genes: np.ndarray | None = None
-        self.steering = np.zeros(4)  # last commanded angles, held while stopped
 
     def on_primitive(self, genes, now: float) -> None:
         """A new primitive from the arbitrator.
@@ -57,10 +50,10 @@ class PrimitiveExecutor:
                 [-1, 1] (the robot's genes map linearly onto its parameter ranges).
         """
         g = np.asarray(genes, dtype=np.float64)
-        if g.shape != (self.robot.n_parameters,):
+        if g.shape != (self.n_parameters,):
             raise InputError(
-                f"primitive has {g.size} values, robot {self.robot.name} expects "
-                f"{self.robot.n_parameters}"
+                f"primitive has {g.size} values, robot {self.robot_name} expects "
+                f"{self.n_parameters}"
             )
         if not np.all(np.isfinite(g)) or np.any(np.abs(g) > 1.0 + 1e-9):
             raise InputError(f"primitive genes must be finite and in [-1, 1], got {g.tolist()}")
@@ -89,13 +82,33 @@ class PrimitiveExecutor:
                 out.append(name)
         return out
 
+    def stop_reason(self, now: float) -> str:
+        """Why the robot must stand still now ("" if it may run the primitive)."""
+        if self.genes is None:
+            return "no primitive yet"
+        stale = self.stale(now)
+        return f"stale input: {', '.join(stale)}" if stale else ""
+
+
+class PrimitiveExecutor(InputWatch):
+    """The 4WS executor: the current primitive as steering angles and a wheel speed."""
+
+    def __init__(
+        self,
+        robot: FourWSType,
+        geometry: FourWSGeometry,
+        inputs: list[str],
+        stale_timeout: float = 0.3,
+    ):
+        super().__init__(robot.name, robot.n_parameters, inputs, stale_timeout)
+        self.robot = robot
+        self.geometry = geometry
+        self.steering = np.zeros(4)  # last commanded angles, held while stopped
+
     def command(self, now: float) -> WheelCommand:
         """The command to send at time ``now``."""
-        stale = self.stale(now)
-        if stale or self.genes is None:
-            reason = (
-                "no primitive yet" if self.genes is None else f"stale input: {', '.join(stale)}"
-            )
+        reason = self.stop_reason(now)
+        if reason:
             return WheelCommand(self.steering.copy(), 0.0, True, reason)
         c = self.robot.commands(self.genes, self.geometry)
         self.steering = c[1:5].copy()

@@ -3,10 +3,15 @@
 Publishes ``/clock`` (rosgraph_msgs/Clock, simulated time), ``scan``
 (sensor_msgs/LaserScan, frame ``base_link``), ``odom`` (nav_msgs/Odometry, ``odom`` ->
 ``base_link``), ``goal`` (geometry_msgs/PointStamped in ``odom``, latched) and
-``joint_states`` (sensor_msgs/JointState: four steering and four wheel joints). Applies the
-ros2_control commands ``steering_position_controller/commands`` (rad) and
-``wheel_velocity_controller/commands`` (rad/s; the robot's single wheel speed is their
-mean times the wheel radius).
+``joint_states`` (sensor_msgs/JointState). Applies ros2_control commands
+(:mod:`sim_bridge.bridge_robots`):
+
+* 4WS robots: ``steering_position_controller/commands`` (rad) and
+  ``wheel_velocity_controller/commands`` (rad/s; the robot's single wheel speed is their
+  mean times the wheel radius); four steering and four wheel joints.
+* the hexapod: ``joint_trajectory_controller/joint_trajectory`` (trajectory_msgs/
+  JointTrajectory, 18 joints, rad), one control period of targets that the physics steps
+  follow; a 25-beam scan over [-90, 90] deg.
 
 Modes:
 * ``lockstep``: wait until the graph is connected; then publish the state, wait for one new
@@ -35,7 +40,6 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState, LaserScan
-from std_msgs.msg import Float64MultiArray
 
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.config import ConfigError
@@ -46,12 +50,12 @@ from evorbc_ros.nodes.common import (
     declare,
     finite_parameter,
 )
-from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES
+from evorbc_ros.robots.hexapod import HEXAPOD
+from sim_bridge.bridge_robots import make_bridge_robot
 from sim_bridge.maze import load_named_maze
-from sim_bridge.world import LaserConfig, SimWorld
 
-STEERING_JOINTS = [f"{w}_steering_joint" for w in WHEEL_NAMES]
-WHEEL_JOINTS = [f"{w}_wheel_joint" for w in WHEEL_NAMES]
+#: Clearance (m) a random start keeps from walls: 4WS robots, the hexapod's legs.
+FOOTPRINT_CLEARANCE = {False: 0.05, True: 0.30}
 
 
 def stamp(seconds: float) -> Time:
@@ -61,7 +65,7 @@ def stamp(seconds: float) -> Time:
 
 
 class SimBridgeNode(Node):
-    """The simulated 4WS robot in a maze."""
+    """The simulated robot (4WS or hexapod) in a maze."""
 
     def __init__(self, **kwargs) -> None:
         super().__init__("sim_bridge", **kwargs)
@@ -72,14 +76,11 @@ class SimBridgeNode(Node):
         start = declare(self, "start", "nominal", "nominal, random, or 'x,y,heading_deg'")
         seed = declare(self, "seed", 0, "seed of a random start")
         episode_time = finite_parameter(
-            self, "episode_time", 120.0, "episode length T (s)", positive=True
-        )
-        self.wheel_radius = finite_parameter(
-            self, "wheel_radius", 0.02, "wheel radius (m)", positive=True
-        )
-        laser = LaserConfig(
-            beams=declare(self, "laser_beams", 360, "laser beams per scan"),
-            range_max=finite_parameter(self, "laser_range", 2.0, "laser range (m)", positive=True),
+            self,
+            "episode_time",
+            30.0 if robot == HEXAPOD else 120.0,
+            "episode length T (s; default 120, hexapod 30)",
+            positive=True,
         )
         self.lockstep_timeout = finite_parameter(
             self,
@@ -97,11 +98,12 @@ class SimBridgeNode(Node):
         self.wait_publishers = declare(
             self,
             "wait_for_publishers",
-            [
-                "steering_position_controller/commands",
-                "wheel_velocity_controller/commands",
-                "evorbc/primitive",
-            ],
+            (
+                ["joint_trajectory_controller/joint_trajectory"]
+                if robot == HEXAPOD
+                else ["steering_position_controller/commands", "wheel_velocity_controller/commands"]
+            )
+            + ["evorbc/primitive"],
             "topics that need a publisher before the run starts",
         )
         self.startup_timeout = finite_parameter(
@@ -113,20 +115,17 @@ class SimBridgeNode(Node):
         )
         if self.mode not in ("lockstep", "realtime"):
             raise StartupError(f"parameter mode must be lockstep or realtime, got {self.mode!r}")
-        if robot not in ROBOT_TYPES:
-            raise StartupError(f"parameter robot must be one of {', '.join(ROBOT_TYPES)}")
-        if laser.beams < 1:
-            raise StartupError("parameter laser_beams must be at least 1")
         try:
             maze = load_named_maze(maze_name)
         except ConfigError as e:
             raise StartupError(f"parameter maze: {e}") from None
-        pose = self._start_pose(maze, start, seed)
-        self.world = SimWorld(maze, robot, pose, episode_time, laser, gui)
+        clearance = FOOTPRINT_CLEARANCE[robot == HEXAPOD]
+        pose = self._start_pose(maze, start, seed, clearance)
+        self.robot = make_bridge_robot(self, robot, maze, pose, episode_time, gui)
+        self.world = self.robot.world
         self.trajectory = [list(self.world.pose)]
-        self.commands = {"steering": None, "wheel": None}
-        self.fresh = {"steering": False, "wheel": False}
-        self.command_times: list[float] = []  # wall-clock arrivals of wheel commands (s)
+        self.fresh = dict.fromkeys(self.robot.command_keys, False)
+        self.command_times: list[float] = []  # wall-clock arrivals of the last key (s)
         self.loop_start = None  # wall clock when the episode started (after the graph)
 
         self.clock_pub = self.create_publisher(Clock, "/clock", RELIABLE)
@@ -134,26 +133,7 @@ class SimBridgeNode(Node):
         self.odom_pub = self.create_publisher(Odometry, "odom", RELIABLE)
         self.joint_pub = self.create_publisher(JointState, "joint_states", RELIABLE)
         self.goal_pub = self.create_publisher(PointStamped, "goal", LATCHED)
-        steering_topic = declare(
-            self,
-            "steering_topic",
-            "steering_position_controller/commands",
-            "steering command topic",
-        )
-        wheel_topic = declare(
-            self, "wheel_topic", "wheel_velocity_controller/commands", "wheel command topic"
-        )
-        self.subs = [
-            self.create_subscription(
-                Float64MultiArray,
-                steering_topic,
-                lambda m: self.on_command("steering", m),
-                RELIABLE,
-            ),
-            self.create_subscription(
-                Float64MultiArray, wheel_topic, lambda m: self.on_command("wheel", m), RELIABLE
-            ),
-        ]
+        self.subs = self.robot.subscribe(self.on_command)
         self.next_progress = self.progress_period
         goal = PointStamped()  # latched: published once, late joiners still get it
         goal.header.frame_id = "odom"
@@ -165,11 +145,11 @@ class SimBridgeNode(Node):
         )
 
     @staticmethod
-    def _start_pose(maze, start: str, seed: int) -> tuple[float, float, float]:
+    def _start_pose(maze, start: str, seed: int, clearance: float) -> tuple[float, float, float]:
         if start == "nominal":
             return maze.start_pose
         if start == "random":
-            return tuple(maze.sample_starts(np.random.default_rng(seed), 1, 0.05)[0])
+            return tuple(maze.sample_starts(np.random.default_rng(seed), 1, clearance)[0])
         try:
             x, y, h = (float(v) for v in start.split(","))
         except ValueError:
@@ -182,28 +162,11 @@ class SimBridgeNode(Node):
 
     # -- commands ----------------------------------------------------------------------
 
-    def on_command(self, which: str, msg: Float64MultiArray) -> None:
-        """Store a command if it has four finite values."""
-        values = np.asarray(msg.data, dtype=np.float64)
-        if values.shape != (4,) or not np.all(np.isfinite(values)):
-            self.get_logger().warning(
-                f"{which} command must be 4 finite values, got {values.tolist()}; ignored",
-                throttle_duration_sec=2.0,
-            )
-            return
-        self.commands[which] = values
-        self.fresh[which] = True
-        if which == "wheel":
+    def on_command(self, key: str) -> None:
+        """A valid command for ``key`` has been stored by the robot adapter."""
+        self.fresh[key] = True
+        if key == self.robot.command_keys[-1]:
             self.command_times.append(time.monotonic())
-
-    def wheel_command(self) -> np.ndarray:
-        """``(speed m/s, fl, fr, rl, rr rad)`` from the latest commands (stopped if none)."""
-        steering = self.commands["steering"]
-        wheel = self.commands["wheel"]
-        if steering is None:
-            steering = self.world.steering
-        speed = 0.0 if wheel is None else float(np.mean(wheel)) * self.wheel_radius
-        return np.concatenate([[speed], steering])
 
     # -- publishing --------------------------------------------------------------------
 
@@ -211,38 +174,37 @@ class SimBridgeNode(Node):
         """Clock, scan, odometry and joint states at the current simulated time."""
         t = stamp(self.world.time)
         self.clock_pub.publish(Clock(clock=t))
-        laser = self.world.laser
+        g = self.robot.scan_geometry
         scan = LaserScan()
         scan.header.stamp = t
         scan.header.frame_id = "base_link"
-        scan.angle_min = laser.angle_min
-        scan.angle_max = laser.angle_min + laser.increment * (laser.beams - 1)
-        scan.angle_increment = laser.increment
-        scan.range_min = laser.range_min
-        scan.range_max = laser.range_max
-        scan.ranges = [float(r) for r in self.world.scan()]
+        scan.angle_min = g.angle_min
+        scan.angle_max = g.angle_max
+        scan.angle_increment = g.angle_increment
+        scan.range_min = g.range_min
+        scan.range_max = g.range_max
+        scan.ranges = [float(r) for r in self.robot.scan()]
         self.scan_pub.publish(scan)
-        x, y, h = self.world.pose
+        (x, y, z), (qx, qy, qz, qw) = self.robot.body_pose()
         odom = Odometry()
         odom.header.stamp = t
         odom.header.frame_id = "odom"
         odom.child_frame_id = "base_link"
         odom.pose.pose.position.x = x
         odom.pose.pose.position.y = y
-        odom.pose.pose.orientation.z = math.sin(0.5 * h)
-        odom.pose.pose.orientation.w = math.cos(0.5 * h)
-        odom.twist.twist.linear.x = self.world.speed
+        odom.pose.pose.position.z = z
+        o = odom.pose.pose.orientation
+        o.x, o.y, o.z, o.w = qx, qy, qz, qw
+        odom.twist.twist.linear.x, odom.twist.twist.angular.z = self.robot.twist()
         self.odom_pub.publish(odom)
         joints = JointState()
         joints.header.stamp = t
-        joints.name = STEERING_JOINTS + WHEEL_JOINTS
-        joints.position = [*self.world.steering.tolist(), *self.world.wheel_angle.tolist()]
-        joints.velocity = [0.0] * 4 + [self.world.speed / self.wheel_radius] * 4
+        self.robot.joint_state(joints)
         self.joint_pub.publish(joints)
 
     def advance(self) -> None:
         """Step the world with the latest commands and log progress."""
-        self.world.step(self.wheel_command(), self.wheel_radius)
+        self.robot.advance()
         self.trajectory.append(list(self.world.pose))
         status = self.world.status()
         if status.time >= self.next_progress - 1e-9:
@@ -318,7 +280,7 @@ class SimBridgeNode(Node):
             self.wait_for_graph(executor)
             self.loop_start = time.monotonic()
             while not self.world.status().done and rclpy.ok():
-                self.fresh = {"steering": False, "wheel": False}
+                self.fresh = dict.fromkeys(self.fresh, False)
                 self.publish_state()
                 self.wait_for_commands(executor)
                 self.advance()
@@ -330,7 +292,7 @@ class SimBridgeNode(Node):
         """Step every 0.1 s of wall time with whatever commands are current."""
         executor = rclpy.executors.SingleThreadedExecutor()
         executor.add_node(self)
-        period = self.world.limits.dt
+        period = self.world.dt
         try:
             self.wait_for_graph(executor)
             self.loop_start = time.monotonic()
@@ -350,7 +312,7 @@ class SimBridgeNode(Node):
         s = self.world.status()
         result = {
             "maze": self.world.maze.name,
-            "robot": self.world.type.name,
+            "robot": self.robot.name,
             "reached": s.reached,
             "time": round(s.time, 3),
             "fitness": s.fitness,

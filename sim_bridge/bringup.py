@@ -22,6 +22,8 @@ from pathlib import Path
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.config import ConfigError
 from evorbc_ros.defaults import default_arbitrator
+from evorbc_ros.robots.hexapod import HEXAPOD
+from sim_bridge.bridge_robots import ROBOTS
 from sim_bridge.maze import load_named_maze, maze_names
 
 NODES = {
@@ -40,11 +42,20 @@ def parse_args(argv=None) -> argparse.Namespace:
         "against the PyBullet simulation bridge, one maze episode.",
     )
     p.add_argument(
-        "--maze",
-        default="obstacle",
-        help=f"maze name ({', '.join(maze_names())}) or file (default: obstacle)",
+        "--robot",
+        choices=ROBOTS,
+        default="",
+        help="robot whose shipped controller runs (default: the arbitrator file's, else 4ws-5)",
     )
-    p.add_argument("--arbitrator", default="", help="arbitrator file (default: the shipped one)")
+    p.add_argument(
+        "--maze",
+        default="",
+        help=f"maze name ({', '.join(maze_names())}) or file "
+        "(default: obstacle for 4WS robots, hexapod for the hexapod)",
+    )
+    p.add_argument(
+        "--arbitrator", default="", help="arbitrator file (default: the shipped one for --robot)"
+    )
     p.add_argument("--repertoire", default="", help="its repertoire (default: the shipped one)")
     p.add_argument(
         "--mode",
@@ -117,9 +128,12 @@ def main(argv=None) -> int:
     """Run one episode through the graph; 0 if it ran (reached or not), 1 on errors."""
     args = parse_args(argv)
     try:
-        maze = load_named_maze(args.maze)
-        arb_path = args.arbitrator or str(default_arbitrator())
+        arb_path = args.arbitrator or str(default_arbitrator(args.robot or "4ws-5"))
         arb = ArbitratorFile.load(arb_path)
+        if args.robot and arb.robot != args.robot:
+            raise ConfigError(f"{arb_path}: is for robot {arb.robot}, not --robot {args.robot}")
+        args.maze = args.maze or ("hexapod" if arb.robot == HEXAPOD else "obstacle")
+        maze = load_named_maze(args.maze)
     except (ConfigError, ArbitratorError) as e:
         print(f"evorbc-sim: error: {e}", file=sys.stderr)
         return 1

@@ -106,6 +106,11 @@ class SimWorld:
         self.physics.show_pose(*self.pose)
 
     @property
+    def dt(self) -> float:
+        """Control period (s)."""
+        return self.limits.dt
+
+    @property
     def pose(self) -> tuple[float, float, float]:
         """``(x m, y m, heading rad)`` in the maze frame (heading not wrapped)."""
         return float(self.state[0, X]), float(self.state[0, Y]), float(self.state[0, HEADING])

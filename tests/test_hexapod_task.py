@@ -4,55 +4,21 @@ import math
 
 import numpy as np
 import pytest
+from hexapod_helpers import tripod_repertoire
 from neat_helpers import neat_config, network_spec, random_genomes
 
 from evorbc_ros.mapping import MappingFunction, nearest_brute_force
 from evorbc_ros.network import NetworkSpec, NodeSpec
-from evorbc_ros.repertoire import Repertoire
-from evorbc_ros.robots.hexapod import mirror_genes, parameter_specs
 from offline_evolution.maze_task.hexapod_task import FOOTPRINT_RADIUS, HexapodMazeTask
 from offline_evolution.maze_task.task import MazeTaskSettings, eq5_fitness
-from sim_bridge.hexapod.evaluate import HEADING, TILT, X, Y, evaluate_genes
-from sim_bridge.hexapod.physics import HexapodSim
 from sim_bridge.maze import load_named_maze
-from sim_bridge.robots.hexapod import DISCARD_TILT
 
 EPISODE = 2.0  # s: 20 control cycles, enough to see the robot walk and turn
 
 
-def tripod(offset_a=0.0):
-    """A tripod gait (see test_hexapod_model.tripod); ``offset_a`` curves the walk."""
-    genes = [0.0]
-    for leg in range(6):
-        phase = 0.0 if leg in (0, 2, 4) else 0.5
-        genes += [offset_a, 1.0, 2 * phase - 1]
-        genes += [0.0, -0.4, 2 * ((phase + 0.75) % 1) - 1]
-    return np.array(genes)
-
-
 @pytest.fixture(scope="module")
 def repertoire():
-    """Six real primitives: straight, curving both ways, and their mirror images."""
-    genes = np.array([tripod(), tripod(0.3), tripod(-0.3)])
-    genes = np.vstack([genes, mirror_genes(genes)])
-    sim = HexapodSim()
-    try:
-        out = evaluate_genes(sim, genes, 2.0, 0.1, DISCARD_TILT)
-    finally:
-        sim.close()
-    assert np.all(out[:, TILT] < DISCARD_TILT)
-    return Repertoire(
-        robot="hexapod",
-        parameters=parameter_specs(),
-        genes=genes,
-        behaviour=out[:, [X, Y]],
-        heading=out[:, HEADING],
-        quality=np.ones(len(genes)),
-        metric="circular+tilt",
-        eval_time=2.0,
-        bin_size=0.08,
-        seed=0,
-    )
+    return tripod_repertoire()
 
 
 def task(workers):
@@ -103,8 +69,8 @@ def test_fitness_is_eq_5_of_the_recorded_distances(repertoire):
     assert not r.reached.any() and not r.fell.any()  # 2 s is far too short to get there
     np.testing.assert_array_equal(r.cycles, 20)
     moved = r.pose[:, -1, :2]
-    # the distances are the maze's path distances, never less than the straight line
-    assert np.all(r.final_distance >= np.linalg.norm(moved - target, axis=1) - 1e-6)
+    # eq. 5 distances: straight lines from the body centre to the target
+    np.testing.assert_allclose(r.final_distance, np.linalg.norm(moved - target, axis=1))
     np.testing.assert_allclose(
         r.fitness, eq5_fitness(r.reached, r.cycles * 0.1, r.final_distance, r.initial_distance, 2)
     )

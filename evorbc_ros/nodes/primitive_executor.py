@@ -1,25 +1,34 @@
-"""``primitive_executor``: runs the current primitive on the 4WS robot's controllers.
+"""``primitive_executor``: runs the current primitive on the robot's controllers.
 
 Subscribes ``evorbc/primitive`` (genes) and, to know that the sensors are alive,
 ``evorbc/rangefinders`` and ``evorbc/goal_sectors``. Publishes, following ros2_control's
-forward command controllers (std_msgs/Float64MultiArray, reliable):
+command conventions (reliable):
 
-* ``steering_position_controller/commands``: the four steering angles (rad; fl, fr, rl, rr)
-* ``wheel_velocity_controller/commands``: the four wheel velocities (rad/s)
+* 4WS robots, forward command controllers (std_msgs/Float64MultiArray):
+  ``steering_position_controller/commands``, the four steering angles (rad; fl, fr, rl,
+  rr), and ``wheel_velocity_controller/commands``, the four wheel velocities (rad/s).
+* the hexapod, joint_trajectory_controller (trajectory_msgs/JointTrajectory):
+  ``joint_trajectory_controller/joint_trajectory``, the 18 joints' targets (rad) for the
+  next 0.1 s, one point per physics step (``trajectory_rate``, 60 Hz), see
+  :mod:`evorbc_ros.hexapod_executor`.
 
 A command goes out at once for every new primitive and at least every 0.1 s (10 Hz). If
 the primitive or a sensor input is older than ``stale_timeout`` (0.3 s) the executor
-commands zero wheel speed, steering held, within one cycle, and resumes when they return.
+stops the robot within one cycle (4WS: zero wheel speed, steering held; hexapod: every
+joint held at its last target), and resumes when they return.
 """
 
 from __future__ import annotations
 
 import sys
 
+from builtin_interfaces.msg import Duration
 from rclpy.node import Node
 from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from evorbc_ros.executor import PrimitiveExecutor, WheelCommand
+from evorbc_ros.hexapod_executor import HexapodExecutor, JointTargets
 from evorbc_ros.laser import InputError
 from evorbc_ros.nodes.common import (
     RELIABLE,
@@ -31,18 +40,19 @@ from evorbc_ros.nodes.common import (
     vector_message,
 )
 from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES, FourWSGeometry
+from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES
+
+ROBOTS = (*ROBOT_TYPES, HEXAPOD)
 
 
 class PrimitiveExecutorNode(Node):
-    """Publishes wheel commands at 10 Hz and stops the robot when inputs go stale."""
+    """Publishes commands at 10 Hz and stops the robot when inputs go stale."""
 
     def __init__(self, **kwargs) -> None:
         super().__init__("primitive_executor", **kwargs)
-        robot = declare(self, "robot", "4ws-5", "robot type: 2ws-2, 2ws-3, 4ws-3 or 4ws-5")
-        if robot not in ROBOT_TYPES:
-            raise StartupError(
-                f"parameter robot must be one of {', '.join(ROBOT_TYPES)}, got {robot!r}"
-            )
+        robot = declare(self, "robot", "4ws-5", f"robot type: {', '.join(ROBOTS)}")
+        if robot not in ROBOTS:
+            raise StartupError(f"parameter robot must be one of {', '.join(ROBOTS)}, got {robot!r}")
         self.wheel_radius = finite_parameter(
             self, "wheel_radius", 0.02, "wheel radius (m), for wheel velocities", positive=True
         )
@@ -71,10 +81,28 @@ class PrimitiveExecutorNode(Node):
             "wheel_velocity_controller/commands",
             "wheel velocities (Float64MultiArray, rad/s)",
         )
-        self.logic = PrimitiveExecutor(ROBOT_TYPES[robot], FourWSGeometry(), list(inputs), stale)
+        trajectory_topic = declare(
+            self,
+            "trajectory_topic",
+            "joint_trajectory_controller/joint_trajectory",
+            "hexapod joint targets (JointTrajectory, rad)",
+        )
+        rate = finite_parameter(
+            self,
+            "trajectory_rate",
+            60.0,
+            "hexapod trajectory points per second (the simulation's physics rate)",
+            positive=True,
+        )
         self.primitive_topic = primitive_topic
-        self.steering_pub = self.create_publisher(Float64MultiArray, steering_topic, RELIABLE)
-        self.wheel_pub = self.create_publisher(Float64MultiArray, wheel_topic, RELIABLE)
+        if robot == HEXAPOD:
+            self.logic = HexapodExecutor(list(inputs), stale, rate)
+            self.trajectory_pub = self.create_publisher(JointTrajectory, trajectory_topic, RELIABLE)
+        else:
+            geometry = FourWSGeometry()
+            self.logic = PrimitiveExecutor(ROBOT_TYPES[robot], geometry, list(inputs), stale)
+            self.steering_pub = self.create_publisher(Float64MultiArray, steering_topic, RELIABLE)
+            self.wheel_pub = self.create_publisher(Float64MultiArray, wheel_topic, RELIABLE)
         self.subs = [
             self.create_subscription(
                 Float64MultiArray, primitive_topic, self.on_primitive, RELIABLE
@@ -118,13 +146,21 @@ class PrimitiveExecutorNode(Node):
         if command.stopped or now - self.last_publish > 1.5 * self.period:
             self.publish(command, now)
 
-    def publish(self, command: WheelCommand, now: float) -> None:
-        """Send one command to both controllers."""
+    def publish(self, command: WheelCommand | JointTargets, now: float) -> None:
+        """Send one command to the robot's controllers."""
         if command.stopped and command.reason != self.stopped_reason:
             self.get_logger().warning(f"stopping the robot: {command.reason}")
         elif not command.stopped and self.stopped_reason:
             self.get_logger().info("inputs are back: running the primitive again")
         self.stopped_reason = command.reason if command.stopped else ""
+        if isinstance(command, JointTargets):
+            self.trajectory_pub.publish(trajectory_message(command))
+        else:
+            self.publish_wheels(command)
+        self.last_publish = now
+
+    def publish_wheels(self, command: WheelCommand) -> None:
+        """Steering angles and wheel velocities for a 4WS robot's two controllers."""
         self.steering_pub.publish(
             vector_message(command.steering, [f"{w}_steering" for w in WHEEL_NAMES])
         )
@@ -133,7 +169,23 @@ class PrimitiveExecutorNode(Node):
                 command.wheel_velocities(self.wheel_radius), [f"{w}_wheel" for w in WHEEL_NAMES]
             )
         )
-        self.last_publish = now
+
+
+def trajectory_message(command: JointTargets) -> JointTrajectory:
+    """A JointTrajectory with point ``k`` at ``k * dt`` s (header stamp 0: start on receipt)."""
+    msg = JointTrajectory()
+    msg.joint_names = list(JOINT_NAMES)
+    points = []
+    for k, row in enumerate(command.positions):
+        ns = round(k * command.dt * 1e9)
+        points.append(
+            JointTrajectoryPoint(
+                positions=row.tolist(),
+                time_from_start=Duration(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000),
+            )
+        )
+    msg.points = points
+    return msg
 
 
 def main(argv=None) -> int:

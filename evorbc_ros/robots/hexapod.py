@@ -186,6 +186,15 @@ class GaitTable:
         return full_pose(self.evolved_targets(t, rows))
 
 
+def gait_step_times(first_step: int, steps: int, dt: float) -> np.ndarray:
+    """Gait times (s) of physics steps ``first_step, first_step + 1, ...``: ``n * dt``.
+
+    The simulation and the onboard executor both count whole steps since the gait began
+    and multiply once, so they sample eq. 10 at bit-identical times.
+    """
+    return (first_step + np.arange(steps)) * dt
+
+
 def full_pose(evolved: np.ndarray) -> np.ndarray:
     """``(m, 18)`` joint targets from ``(m, 12)`` A/B targets: each shin kept vertical."""
     evolved = np.atleast_2d(evolved)

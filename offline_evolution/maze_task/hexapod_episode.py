@@ -26,12 +26,10 @@ from evorbc_ros.mapping import MappingFunction, PrimitiveLookup
 from evorbc_ros.network import NetworkSpec
 from evorbc_ros.robots.hexapod import GaitTable, HexapodGeometry
 from evorbc_ros.sensors import SensorLayout
+from sim_bridge.hexapod.maze_world import FALLEN_TILT
 from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings
 from sim_bridge.hexapod.scanner import Scanner
 from sim_bridge.maze import Maze
-
-#: Body tilt (rad) at which a hexapod has fallen over: the episode ends there.
-FALLEN_TILT = math.radians(90.0)
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as p
 
-from evorbc_ros.robots.hexapod import HexapodGeometry
+from evorbc_ros.robots.hexapod import HexapodGeometry, gait_step_times
 from sim_bridge.hexapod.urdf import hexapod_urdf
 
 #: Collision groups: laser rays see only walls; the robot touches ground and walls.
@@ -127,8 +127,9 @@ class HexapodSim:
         self.robot = self._load_robot(rest_xy)
         self.joints = list(range(p.getNumJoints(self.robot, physicsClientId=c)))
         self.torques = self.geometry.joint_torques().tolist()
-        self.time = 0.0  # s since the last reset
+        self.steps_done = 0  # physics steps since the last reset
         self._rest_state, self._rest_pose = self._settle()
+        self.steps_done = 0  # the clock starts at rest
 
     # -- building the world --------------------------------------------------------
 
@@ -206,7 +207,7 @@ class HexapodSim:
         """
         c = self.client
         p.restoreState(self._rest_state, physicsClientId=c)
-        self.time = 0.0
+        self.steps_done = 0
         if x is None or y is None or heading is None:
             return
         (_, _, pz), orn = self._rest_pose
@@ -230,9 +231,18 @@ class HexapodSim:
         (x, y, _), orn = self._rest_pose
         return x, y, _yaw(orn)
 
+    @property
+    def time(self) -> float:
+        """Seconds since the last reset (whole physics steps)."""
+        return self.steps_done * self.physics.dt
+
     def step_times(self, steps: int) -> np.ndarray:
-        """``(steps,)`` times (s since the last reset) at which the next steps start."""
-        return self.time + self.physics.dt * np.arange(steps)
+        """``(steps,)`` times (s since the last reset) at which the next steps start.
+
+        Counted in whole steps times ``dt`` (never accumulated), so the onboard executor,
+        which counts gait steps from the clock, computes bit-identical times.
+        """
+        return gait_step_times(self.steps_done, steps, self.physics.dt)
 
     def run(self, targets: np.ndarray, max_tilt: float = math.inf) -> tuple[float, float]:
         """Run one physics step per row of ``targets``, the servos tracking that row.
@@ -250,7 +260,6 @@ class HexapodSim:
         c, robot, joints = self.client, self.robot, self.joints
         gain = self.geometry.position_gain
         v_max = self.geometry.max_joint_velocity
-        dt = self.physics.dt
         torques = self.torques
         velocity_control = p.VELOCITY_CONTROL
         get_states, set_motors = p.getJointStates, p.setJointMotorControlArray
@@ -270,7 +279,7 @@ class HexapodSim:
                 physicsClientId=c,
             )
             step(physicsClientId=c)
-            self.time += dt
+            self.steps_done += 1
             (x, y, _), orn = get_pose(robot, physicsClientId=c)
             path += math.hypot(x - x0, y - y0)
             x0, y0 = x, y

@@ -1,0 +1,242 @@
+"""The robot-specific half of the simulation bridge: a 4WS robot or the hexapod.
+
+Each adapter owns its simulated world, subscribes its command topics, fills the joint
+states and laser scan, and steps the world with the commands of the cycle. The bridge node
+(:mod:`sim_bridge.bridge_node`) runs the loop, clock, odometry and result the same way for
+both.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory
+
+from evorbc_ros.nodes.common import RELIABLE, StartupError, declare, finite_parameter
+from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES
+from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES
+from sim_bridge.hexapod.maze_world import HexapodMazeWorld
+from sim_bridge.world import LaserConfig, SimWorld
+
+STEERING_JOINTS = [f"{w}_steering_joint" for w in WHEEL_NAMES]
+WHEEL_JOINTS = [f"{w}_wheel_joint" for w in WHEEL_NAMES]
+ROBOTS = (*ROBOT_TYPES, HEXAPOD)
+
+
+@dataclass(frozen=True)
+class ScanGeometry:
+    """What a LaserScan message says about the beams (rad, m)."""
+
+    angle_min: float
+    angle_max: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+
+
+class FourWSBridge:
+    """A 4WS robot: steering angles and wheel velocities in, kinematic motion model."""
+
+    #: Command topics the lockstep loop waits for each cycle (parameter names).
+    command_keys = ("steering", "wheel")
+
+    def __init__(self, node, robot: str, maze, pose, episode_time: float, gui: bool) -> None:
+        self.node = node
+        self.wheel_radius = finite_parameter(
+            node, "wheel_radius", 0.02, "wheel radius (m)", positive=True
+        )
+        laser = LaserConfig(
+            beams=declare(node, "laser_beams", 360, "laser beams per scan"),
+            range_max=finite_parameter(node, "laser_range", 2.0, "laser range (m)", positive=True),
+        )
+        if laser.beams < 1:
+            raise StartupError("parameter laser_beams must be at least 1")
+        self.topics = {
+            "steering": declare(
+                node,
+                "steering_topic",
+                "steering_position_controller/commands",
+                "steering command topic",
+            ),
+            "wheel": declare(
+                node, "wheel_topic", "wheel_velocity_controller/commands", "wheel command topic"
+            ),
+        }
+        self.world = SimWorld(maze, robot, pose, episode_time, laser, gui)
+        self.commands: dict[str, np.ndarray | None] = {"steering": None, "wheel": None}
+        self.scan_geometry = ScanGeometry(
+            laser.angle_min,
+            laser.angle_min + laser.increment * (laser.beams - 1),
+            laser.increment,
+            laser.range_min,
+            laser.range_max,
+        )
+
+    @property
+    def name(self) -> str:
+        """Robot type."""
+        return self.world.type.name
+
+    def subscribe(self, on_command) -> list:
+        """Subscriptions calling ``on_command(key)`` after a valid command is stored."""
+        return [
+            self.node.create_subscription(
+                Float64MultiArray, topic, lambda m, k=key: self._store(k, m, on_command), RELIABLE
+            )
+            for key, topic in self.topics.items()
+        ]
+
+    def _store(self, key: str, msg: Float64MultiArray, on_command) -> None:
+        values = np.asarray(msg.data, dtype=np.float64)
+        if values.shape != (4,) or not np.all(np.isfinite(values)):
+            self.node.get_logger().warning(
+                f"{self.topics[key]}: command must be 4 finite values, got {values.tolist()}; "
+                "ignored",
+                throttle_duration_sec=2.0,
+            )
+            return
+        self.commands[key] = values
+        on_command(key)
+
+    def wheel_command(self) -> np.ndarray:
+        """``(speed m/s, fl, fr, rl, rr rad)`` from the latest commands (stopped if none)."""
+        steering = self.commands["steering"]
+        wheel = self.commands["wheel"]
+        if steering is None:
+            steering = self.world.steering
+        speed = 0.0 if wheel is None else float(np.mean(wheel)) * self.wheel_radius
+        return np.concatenate([[speed], steering])
+
+    def advance(self) -> None:
+        """One control period with the latest commands."""
+        self.world.step(self.wheel_command(), self.wheel_radius)
+
+    def scan(self) -> np.ndarray:
+        """Laser ranges (m)."""
+        return self.world.scan()
+
+    def twist(self) -> tuple[float, float]:
+        """Forward speed (m/s) and yaw rate (rad/s) in the body frame."""
+        return self.world.speed, 0.0
+
+    def body_pose(self) -> tuple[tuple, tuple]:
+        """Position (m) and orientation (xyzw) of ``base_link`` in ``odom``: planar."""
+        x, y, h = self.world.pose
+        return (x, y, 0.0), (0.0, 0.0, math.sin(0.5 * h), math.cos(0.5 * h))
+
+    def joint_state(self, msg: JointState) -> None:
+        """Fill the joint names, positions and velocities."""
+        msg.name = STEERING_JOINTS + WHEEL_JOINTS
+        msg.position = [*self.world.steering.tolist(), *self.world.wheel_angle.tolist()]
+        msg.velocity = [0.0] * 4 + [self.world.speed / self.wheel_radius] * 4
+
+
+class HexapodBridge:
+    """The hexapod: a JointTrajectory of targets per control period, PyBullet dynamics."""
+
+    command_keys = ("trajectory",)
+
+    def __init__(self, node, robot: str, maze, pose, episode_time: float, gui: bool) -> None:
+        self.node = node
+        self.topic = declare(
+            node,
+            "trajectory_topic",
+            "joint_trajectory_controller/joint_trajectory",
+            "joint trajectory command topic",
+        )
+        self.world = HexapodMazeWorld(maze, pose, episode_time, gui)
+        self.trajectory: np.ndarray | None = None
+        s = self.world.scanner
+        self.scan_geometry = ScanGeometry(
+            s.angle_min, s.angle_max, s.angle_increment, s.range_min, s.range_max
+        )
+        self.index = {name: k for k, name in enumerate(JOINT_NAMES)}
+        self.dt = self.world.physics.dt
+
+    name = HEXAPOD
+
+    def subscribe(self, on_command) -> list:
+        """The trajectory subscription; ``on_command("trajectory")`` once one is stored."""
+        return [
+            self.node.create_subscription(
+                JointTrajectory, self.topic, lambda m: self._store(m, on_command), RELIABLE
+            )
+        ]
+
+    def _store(self, msg: JointTrajectory, on_command) -> None:
+        problem, rows = self._targets(msg)
+        if problem:
+            self.node.get_logger().warning(
+                f"{self.topic}: {problem}; ignored", throttle_duration_sec=2.0
+            )
+            return
+        self.trajectory = rows
+        on_command("trajectory")
+
+    def _targets(self, msg: JointTrajectory) -> tuple[str, np.ndarray | None]:
+        """``(problem, (steps, 18) targets)``: points resampled at the physics steps."""
+        names = list(msg.joint_names)
+        if sorted(names) != sorted(JOINT_NAMES):
+            return f"expected the 18 joints {', '.join(JOINT_NAMES)}, got {names}", None
+        if not msg.points:
+            return "trajectory has no points", None
+        order = [names.index(n) for n in JOINT_NAMES]
+        times, rows = [], []
+        for point in msg.points:
+            q = np.asarray(point.positions, dtype=np.float64)
+            if q.shape != (18,) or not np.all(np.isfinite(q)):
+                return "every point needs 18 finite positions", None
+            rows.append(q[order])
+            times.append(point.time_from_start.sec + 1e-9 * point.time_from_start.nanosec)
+        times = np.asarray(times)
+        if np.any(np.diff(times) <= 0):
+            return "point times must increase", None
+        # Zero-order hold: physics step k (at k * dt) tracks the last point due by then.
+        steps = self.world.steps_per_period
+        due = np.searchsorted(times, np.arange(steps) * self.dt + 1e-6, side="right") - 1
+        return "", np.asarray(rows)[np.clip(due, 0, None)]
+
+    def advance(self) -> None:
+        """One control period through the latest trajectory (held once it is used up)."""
+        self.world.step(self.trajectory)
+        if self.trajectory is not None:
+            self.trajectory = self.trajectory[-1:]  # hold the last target until the next
+
+    def scan(self) -> np.ndarray:
+        """Laser ranges (m), float32 as LaserScan carries them."""
+        return self.world.scan()
+
+    def twist(self) -> tuple[float, float]:
+        """Forward speed (m/s) and yaw rate (rad/s) of the body, body frame."""
+        _, _, (vx, vy, _), (_, _, wz) = self.world.sim.base_state()
+        heading = self.world.pose[2]
+        return vx * math.cos(heading) + vy * math.sin(heading), wz
+
+    def body_pose(self) -> tuple[tuple, tuple]:
+        """Position (m) and full 3D orientation (xyzw) of the body, as PyBullet has them.
+
+        The radar node takes the yaw from this quaternion exactly as offline evolution
+        takes it from PyBullet's, so the goal bearing is bit-identical.
+        """
+        pos, orn, _, _ = self.world.sim.base_state()
+        return tuple(pos), tuple(orn)
+
+    def joint_state(self, msg: JointState) -> None:
+        """Fill the 18 joints' names, angles (rad), velocities (rad/s) and torques (N m)."""
+        q, v, tau = self.world.sim.joint_states()
+        msg.name = list(JOINT_NAMES)
+        msg.position = q.tolist()
+        msg.velocity = v.tolist()
+        msg.effort = tau.tolist()
+
+
+def make_bridge_robot(node, robot: str, maze, pose, episode_time: float, gui: bool):
+    """The adapter for ``robot``."""
+    if robot not in ROBOTS:
+        raise StartupError(f"parameter robot must be one of {', '.join(ROBOTS)}")
+    kind = HexapodBridge if robot == HEXAPOD else FourWSBridge
+    return kind(node, robot, maze, pose, episode_time, gui)

@@ -1,0 +1,99 @@
+"""The simulated ROS 2 graph as separate processes, for tests (localhost discovery)."""
+
+import json
+import os
+import signal
+import subprocess
+
+import numpy as np
+
+from evorbc_ros.defaults import default_arbitrator
+from sim_bridge.bringup import NODES, node_command
+
+
+def graph_env(domain: int) -> dict:
+    env = dict(
+        os.environ,
+        ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+        PYTHONUNBUFFERED="1",
+        ROS_DOMAIN_ID=str(domain),
+    )
+    return env
+
+
+class GraphRun:
+    """The five processes of the simulated graph; the arbitrator records its choices."""
+
+    def __init__(
+        self,
+        tmp_path,
+        domain,
+        maze,
+        mode="lockstep",
+        episode_time=120.0,
+        arbitrator=None,
+        repertoire="",
+        robot="4ws-5",
+    ):
+        self.env = graph_env(domain)
+        self.result = tmp_path / f"{maze}-{mode}.json"
+        self.log = open(tmp_path / f"{maze}-{mode}.log", "w")  # noqa: SIM115
+        self.arb = str(arbitrator or default_arbitrator())
+        self.choices = tmp_path / f"{maze}-{mode}.choices.jsonl"
+        self.procs = {}
+        for name, module in NODES.items():
+            params = {"use_sim_time": True}
+            if name in ("laser_sensor", "radar_sensor"):
+                params["sensor_layout"] = self.arb
+            if name == "arbitrator":
+                params.update(
+                    record_file=str(self.choices), arbitrator=self.arb, repertoire=str(repertoire)
+                )
+            if name == "primitive_executor":
+                params["robot"] = robot
+            self.start(name, module, params)
+        self.bridge = self.start(
+            "sim_bridge",
+            "sim_bridge.bridge_node",
+            {
+                "maze": maze,
+                "robot": robot,
+                "mode": mode,
+                "result_file": str(self.result),
+                "episode_time": episode_time,
+            },
+        )
+
+    def start(self, name, module, params):
+        proc = subprocess.Popen(
+            node_command(module, params),
+            env=self.env,
+            stdout=self.log,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )
+        self.procs[name] = proc
+        return proc
+
+    def wait(self, timeout):
+        self.bridge.wait(timeout)
+        return json.loads(self.result.read_text())
+
+    def recorded_choices(self):
+        """The primitive the arbitrator chose at each cycle (its record file)."""
+        rows = [json.loads(line) for line in self.choices.read_text().splitlines()]
+        return np.array([int(r[4]) for r in rows])
+
+    def stop(self):
+        for p in self.procs.values():
+            if p.poll() is None:
+                p.send_signal(signal.SIGINT)
+        for p in self.procs.values():
+            try:
+                p.wait(5)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+        self.log.close()
+
+
