@@ -1,15 +1,22 @@
 """The hexapod through the ROS 2 graph: the executor's trajectories and lockstep parity
 with the offline episode, cycle by cycle."""
 
+import math
+
 import numpy as np
 import pytest
+from builtin_interfaces.msg import Duration
 from graph_helpers import GraphRun
 from hexapod_helpers import tripod_repertoire
 from neat_helpers import neat_config, network_spec, random_genomes
+from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.hexapod_executor import HexapodExecutor
-from evorbc_ros.robots.hexapod import GaitTable
+from evorbc_ros.nodes.common import vector_message
+from evorbc_ros.nodes.primitive_executor import PrimitiveExecutorNode
+from evorbc_ros.robots.hexapod import JOINT_NAMES, GaitTable
 from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
 from offline_evolution.maze_task.replay import replay
 from offline_evolution.maze_task.task import MazeTaskSettings
@@ -97,3 +104,78 @@ def test_lockstep_graph_reproduces_the_offline_episode(tmp_path, controller):
     np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
     assert got["robot"] == "hexapod" and got["fitness"] == pytest.approx(outcome.fitness)
     assert np.hypot(*(trajectory[-1, :2] - trajectory[0, :2])) > 0.2  # it walked
+
+
+def test_executor_node_sends_a_period_of_targets_and_holds_on_stale_input(ros):
+    node = ros.make(PrimitiveExecutorNode, sim_time=True, robot="hexapod")
+    got = ros.listen(JointTrajectory, "joint_trajectory_controller/joint_trajectory")
+    prim = ros.publisher(Float64MultiArray, "evorbc/primitive")
+    rf = ros.publisher(Float64MultiArray, "evorbc/rangefinders")
+    gs = ros.publisher(Float64MultiArray, "evorbc/goal_sectors")
+    for p in (prim, rf, gs):
+        ros.connected(p)
+    genes = np.linspace(-1, 1, 37)
+    ros.set_clock(2.0)
+    rf.publish(vector_message([0.0] * 5))
+    gs.publish(vector_message([0.5]))
+    prim.publish(vector_message(genes))
+    assert ros.spin_until(lambda: got and len(got[-1].points) == 6)
+    msg = got[-1]
+    assert list(msg.joint_names) == list(JOINT_NAMES) and len(msg.points) == 6
+    steps = [p.time_from_start.sec + 1e-9 * p.time_from_start.nanosec for p in msg.points]
+    np.testing.assert_allclose(steps, np.arange(6) / 60.0, atol=1e-9)
+    want = GaitTable(genes).joint_targets(np.arange(6) / 60.0, np.zeros(6, dtype=int))
+    np.testing.assert_array_equal([p.positions for p in msg.points], want)
+    assert not node.stopped_reason
+    # Nothing new for more than 0.3 s: the legs hold their last targets.
+    ros.set_clock(2.5)
+    assert ros.spin_until(lambda: node.stopped_reason != "")
+    assert ros.spin_until(lambda: len(got[-1].points) == 1)
+    np.testing.assert_array_equal(got[-1].points[0].positions, want[-1])
+
+
+def test_bridge_skips_malformed_trajectories_and_holds_the_last_targets():
+    class Node:  # the adapter needs a node only for parameters, subscriptions and logs
+        def __init__(self):
+            self.warnings = []
+
+        def declare_parameter(self, name, value, descriptor=None):
+            return type("P", (), {"value": value})()
+
+        def get_logger(self):
+            node = self
+
+            class Log:
+                def warning(self, text, **_):
+                    node.warnings.append(text)
+
+            return Log()
+
+    from sim_bridge.bridge_robots import HexapodBridge
+    from sim_bridge.maze import load_named_maze
+
+    node = Node()
+    bridge = HexapodBridge(node, "hexapod", load_named_maze("hexapod"), None, 30.0, False)
+    try:
+        stored = []
+        good = JointTrajectory(joint_names=list(reversed(JOINT_NAMES)))
+        q = np.arange(18, dtype=float) / 100.0
+        good.points = [
+            JointTrajectoryPoint(positions=q[::-1].tolist(), time_from_start=Duration()),
+            JointTrajectoryPoint(
+                positions=(2 * q[::-1]).tolist(), time_from_start=Duration(nanosec=50_000_000)
+            ),
+        ]
+        bridge._store(good, stored.append)
+        # reordered by joint name; step k at k / 60 s holds the last point due by then
+        np.testing.assert_allclose(bridge.trajectory, [q, q, q, 2 * q, 2 * q, 2 * q])
+        bad = JointTrajectory(joint_names=list(JOINT_NAMES))
+        bad.points = [JointTrajectoryPoint(positions=[math.nan] * 18)]
+        bridge._store(bad, stored.append)
+        bridge._store(JointTrajectory(joint_names=["x"]), stored.append)
+        assert stored == ["trajectory"] and len(node.warnings) == 2
+        assert "finite" in node.warnings[0] and "18 joints" in node.warnings[1]
+        bridge.advance()
+        np.testing.assert_allclose(bridge.world.targets, 2 * q)
+    finally:
+        bridge.world.close()
