@@ -9,7 +9,6 @@ from builtin_interfaces.msg import Duration
 from graph_helpers import GraphRun
 from hexapod_helpers import tripod_repertoire
 from neat_helpers import neat_config, network_spec, random_genomes
-from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from evorbc_ros.arbitrator import ArbitratorFile
@@ -109,11 +108,7 @@ def test_lockstep_graph_reproduces_the_offline_episode(tmp_path, controller):
 def test_executor_node_sends_a_period_of_targets_and_holds_on_stale_input(ros):
     node = ros.make(PrimitiveExecutorNode, sim_time=True, robot="hexapod")
     got = ros.listen(JointTrajectory, "joint_trajectory_controller/joint_trajectory")
-    prim = ros.publisher(Float64MultiArray, "evorbc/primitive")
-    rf = ros.publisher(Float64MultiArray, "evorbc/rangefinders")
-    gs = ros.publisher(Float64MultiArray, "evorbc/goal_sectors")
-    for p in (prim, rf, gs):
-        ros.connected(p)
+    prim, rf, gs = ros.executor_inputs()
     genes = np.linspace(-1, 1, 37)
     ros.set_clock(2.0)
     rf.publish(vector_message([0.0] * 5))

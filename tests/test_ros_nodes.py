@@ -144,11 +144,7 @@ def test_executor_stops_within_a_cycle_of_stale_input_and_resumes(ros):
     node = ros.make(PrimitiveExecutorNode, sim_time=True, robot="4ws-5")
     wheels = ros.listen(Float64MultiArray, "wheel_velocity_controller/commands")
     steering = ros.listen(Float64MultiArray, "steering_position_controller/commands")
-    prim = ros.publisher(Float64MultiArray, "evorbc/primitive")
-    rf = ros.publisher(Float64MultiArray, "evorbc/rangefinders")
-    gs = ros.publisher(Float64MultiArray, "evorbc/goal_sectors")
-    for p in (prim, rf, gs):
-        ros.connected(p)
+    prim, rf, gs = ros.executor_inputs()
     genes = [1.0, 0.5, 0.5, -0.5, -0.5]  # full speed, toe-in steering
 
     def cycle(t, with_rangefinders=True):
@@ -188,11 +184,7 @@ def test_executor_stops_within_a_cycle_of_stale_input_and_resumes(ros):
 def test_executor_stops_when_the_arbitrator_falls_silent(ros):
     ros.make(PrimitiveExecutorNode, sim_time=True)
     wheels = ros.listen(Float64MultiArray, "wheel_velocity_controller/commands")
-    prim = ros.publisher(Float64MultiArray, "evorbc/primitive")
-    rf = ros.publisher(Float64MultiArray, "evorbc/rangefinders")
-    gs = ros.publisher(Float64MultiArray, "evorbc/goal_sectors")
-    for p in (prim, rf, gs):
-        ros.connected(p)
+    prim, rf, gs = ros.executor_inputs()
     ros.set_clock(1.0)
     rf.publish(vector_message([0.0] * 6))
     gs.publish(vector_message([1, 0, 0, 0]))
