@@ -1,0 +1,174 @@
+"""Check the hexapod experiment against the paper (Sec. V-B and V-C).
+
+Given one hexapod repertoire (made by ``evorbc-evolve repertoire --robot hexapod``), runs
+through the CLI, so every run is a command a user can repeat:
+
+* EvoRBC arbitrators for seeds 1..N (Table I: 200 generations, polar mapping);
+* standard NEAT for seed 1..M with the equal-budget generations (200 + 455).
+
+Then reports, next to the paper's values: the repertoire's size, quality and left/right
+symmetry; EvoRBC's best fitness (mean +- sd), how many runs reached the goal and the first
+generation that did; how far standard NEAT got (eq. 5 fitness, 1 - d_final/d_initial when
+it does not arrive); and how often the selected arbitrator switches primitive.
+
+Every run checkpoints each generation and resumes when the experiment is started again;
+finished runs are skipped.
+
+Run: ``python -m offline_evolution.experiments.hexapod_check --repertoire REP.json
+--out DIR [--seeds 3] [--standard-seeds 1] [--summarise-only]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from evorbc_ros.arbitrator import ArbitratorFile
+from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.config import build_settings
+from evorbc_ros.repertoire import Repertoire
+from offline_evolution.repertoire.stats import repertoire_stats
+
+PAPER = {
+    "count": 336,
+    "quality": "1.69 ± 0.24",
+    "evorbc": "1.28 ± 0.02, goal reached in 5 of 5 runs, about 25 generations to first reach",
+    "standard": "about the middle of the maze",
+    "switch": "about every 1.9 cycles",
+}
+
+
+def cli(*args: str) -> None:
+    """Run ``evorbc-evolve`` with ``args`` (it resumes from its own checkpoint)."""
+    cmd = [sys.executable, "-m", "offline_evolution.cli", *args]
+    print("$ evorbc-evolve " + " ".join(args), flush=True)
+    subprocess.run(cmd, check=True)
+
+
+def run_all(repertoire: Path, out: Path, seeds: list[int], standard_seeds: list[int]) -> None:
+    """Every run that is not finished yet, EvoRBC first."""
+    for seed in seeds:
+        path = out / f"evorbc-seed{seed}.json"
+        if not path.exists():
+            cli(
+                "arbitrator",
+                "--repertoire",
+                str(repertoire),
+                "--seed",
+                str(seed),
+                "--out",
+                str(path),
+            )
+    for seed in standard_seeds:
+        path = out / f"standard-seed{seed}.json"
+        if not path.exists():
+            cli(
+                "standard", "--robot", "hexapod", "--equal-budget", "--seed", str(seed),
+                "--out", str(path),
+            )  # fmt: skip
+
+
+def replay_switches(arbitrator: Path, repertoire: Path) -> tuple[float, bool, float]:
+    """Primitive switches per cycle, reached, and fitness from the maze's nominal start."""
+    from offline_evolution.maze_task.replay import replay
+    from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+
+    arb = ArbitratorFile.load(arbitrator)
+    rep = Repertoire.load(repertoire)
+    settings = build_settings(MazeTaskSettings, arb.evolution["task"], f"{arbitrator}: task")
+    task = make_task(settings, arb.robot, workers=1)
+    try:
+        outcomes, _ = replay(arb, task, task.nominal_starts(), rep)
+    finally:
+        task.close()
+    o = outcomes[0]
+    return o.switches_per_cycle, o.reached, o.fitness
+
+
+def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: list[int]) -> str:
+    """The Markdown comparison with the paper, written to ``OUT/hexapod-check.md``."""
+    rep = Repertoire.load(repertoire)
+    s = repertoire_stats(rep)
+    lines = [
+        "| figure | here | paper |",
+        "|---|---|---|",
+        f"| repertoire size | {s['count']} primitives ({rep.algorithm.get('evaluations', 0):,} "
+        f"evaluations, {rep.algorithm.get('variation', 'paper')} operator) | {PAPER['count']} |",
+        f"| repertoire quality | {s['mean_quality']:.2f} ± {s['sd_quality']:.2f} | "
+        f"{PAPER['quality']} |",
+        f"| left/right symmetry (off-axis cells with a filled mirror cell) | "
+        f"{100 * s['mirrored']:.0f} %, left/right {s['left']}/{s['right']} | "
+        "asymmetric (Fig. 16) |",
+    ]
+    evo = [_evolution(out / f"evorbc-seed{k}.json") for k in seeds]
+    evo = [e for e in evo if e is not None]
+    if evo:
+        best = np.array([e["best_fitness"] for e in evo])
+        reached = sum(e["best_reached"] >= 1 for e in evo)
+        firsts = [
+            next((h["generation"] for h in e["history"] if h["best_reached"] >= 1), None)
+            for e in evo
+        ]
+        first_text = ", ".join("never" if f is None else str(f) for f in firsts)
+        sd = f" ± {best.std(ddof=1):.2f}" if len(best) > 1 else ""
+        lines.append(
+            f"| EvoRBC best fitness, {len(evo)} run(s) of {evo[0]['generations']} generations "
+            f"| {best.mean():.2f}{sd}; goal reached in {reached} of {len(evo)}; first reached "
+            f"at generation {first_text} | {PAPER['evorbc']} |"
+        )
+        switches = []
+        for k in seeds:
+            path = out / f"evorbc-seed{k}.json"
+            if path.exists():
+                per_cycle, _, _ = replay_switches(path, repertoire)
+                switches.append(per_cycle)
+        rate = np.mean(switches)
+        lines.append(
+            f"| primitive switches of the selected arbitrators (nominal start) | "
+            f"{rate:.2f} per cycle, about every {1 / rate:.1f} cycles | {PAPER['switch']} |"
+            if rate > 0
+            else "| primitive switches | never switched | " + PAPER["switch"] + " |"
+        )
+    std = [_evolution(out / f"standard-seed{k}.json") for k in standard_seeds]
+    std = [e for e in std if e is not None]
+    if std:
+        best = np.array([e["best_fitness"] for e in std])
+        lines.append(
+            f"| standard NEAT best fitness, {len(std)} run(s) of {std[0]['generations']} "
+            f"generations | {best.mean():.2f}: covered {100 * best.mean():.0f} % of the "
+            f"straight-line distance to the goal, goal reached in "
+            f"{sum(e['best_reached'] >= 1 for e in std)} of {len(std)} | {PAPER['standard']} |"
+        )
+    text = "\n".join(lines) + "\n"
+    atomic_write_text(out / "hexapod-check.md", text)
+    return text
+
+
+def _evolution(path: Path) -> dict | None:
+    return json.loads(path.read_text())["evolution"] if path.exists() else None
+
+
+def main() -> None:
+    """Command-line entry point."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--repertoire", type=Path, required=True)
+    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--seeds", type=int, default=3, help="EvoRBC runs (seeds 1..N)")
+    parser.add_argument("--standard-seeds", type=int, default=1, help="standard-NEAT runs")
+    parser.add_argument("--summarise-only", action="store_true")
+    args = parser.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    seeds = list(range(1, args.seeds + 1))
+    standard = list(range(1, args.standard_seeds + 1))
+    if not args.summarise_only:
+        run_all(args.repertoire, args.out, seeds, standard)
+    print(summarise(args.repertoire, args.out, seeds, standard))
+
+
+if __name__ == "__main__":
+    main()
