@@ -95,5 +95,3 @@ class GraphRun:
                 p.kill()
                 p.wait()
         self.log.close()
-
-

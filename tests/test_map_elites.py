@@ -253,3 +253,20 @@ def test_symmetry_counts_filled_cells_whose_mirror_cell_is_filled(small_repertoi
     assert s["mirrored"] == pytest.approx(2 / 3)
     assert (s["left"], s["right"]) == (3, 1)
     assert s["qd_score"] == pytest.approx(6.2)
+
+
+def test_hexapod_run_resumes_to_the_uninterrupted_result(tmp_path):
+    settings = load_settings(robot="hexapod", initial_batch=40, batch_size=20, iterations=3, seed=2)
+    whole = generate_repertoire(settings, workers=1)
+    assert whole.robot == "hexapod" and len(whole) > 10
+    assert whole.algorithm["simulation"]["physics"]["rate_hz"] == 60.0
+    ckpt = tmp_path / "hexapod.checkpoint.npz"
+    polls = []
+    with pytest.raises(Interrupted):
+        generate_repertoire(
+            settings,
+            checkpoint=ckpt,
+            workers=1,
+            should_stop=lambda: polls.append(1) or len(polls) == 3,  # inside iteration 1
+        )
+    assert_same_repertoire(generate_repertoire(settings, checkpoint=ckpt, workers=1), whole)
