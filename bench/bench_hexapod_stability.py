@@ -36,6 +36,14 @@ VARIANTS = {
         "tibia_length": 0.11,
         "femur_length": 0.10,
     },
+    "servos 5 rad/s": {"max_joint_velocity": 5.0},
+    "servos 5 rad/s, tibia 0.10": {"max_joint_velocity": 5.0, "tibia_length": 0.10},
+    "servos 1.5 N m, tibia 0.10": {
+        "coxa_torque": 1.5,
+        "femur_torque": 1.5,
+        "tibia_torque": 1.5,
+        "tibia_length": 0.10,
+    },
 }
 
 
