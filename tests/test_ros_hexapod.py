@@ -174,3 +174,14 @@ def test_bridge_skips_malformed_trajectories_and_holds_the_last_targets():
         np.testing.assert_allclose(bridge.world.targets, 2 * q)
     finally:
         bridge.world.close()
+
+
+def test_evorbc_sim_refuses_an_arbitrator_for_another_robot(capsys):
+    from evorbc_ros.defaults import default_arbitrator
+    from sim_bridge.bringup import main
+
+    assert main(["--robot", "hexapod", "--arbitrator", str(default_arbitrator())]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"evorbc-sim: error: {default_arbitrator()}: is for robot 4ws-5, not --robot hexapod"
+    ]
