@@ -16,16 +16,15 @@ walkers), and counts falls (tilt past 90 deg):
 from __future__ import annotations
 
 import argparse
-import math
 
 import numpy as np
 
 from evorbc_ros.robots.hexapod import GaitTable, HexapodGeometry
 from sim_bridge.hexapod.evaluate import TILT, X, Y, evaluate_genes
+from sim_bridge.hexapod.maze_world import FALLEN_TILT
 from sim_bridge.hexapod.physics import HexapodSim
+from sim_bridge.robots.hexapod import DISCARD_TILT
 
-FALLEN = math.radians(90.0)
-DISCARD = math.radians(45.0)
 VARIANTS = {
     "current (coxa 0.06, tibia 0.14)": {},
     "coxa 0.10": {"coxa_length": 0.10},
@@ -53,8 +52,10 @@ def episode(sim: HexapodSim, table: GaitTable, rows: np.ndarray, hold: int) -> b
     steps = sim.physics.steps(sim.geometry.control_period)
     for cycle in range(len(rows) * hold):
         row = rows[cycle // hold]
-        tilt, _ = sim.run(table.joint_targets(sim.step_times(steps), np.full(steps, row)), FALLEN)
-        if tilt > FALLEN:
+        tilt, _ = sim.run(
+            table.joint_targets(sim.step_times(steps), np.full(steps, row)), FALLEN_TILT
+        )
+        if tilt > FALLEN_TILT:
             return True
     return False
 
@@ -66,8 +67,8 @@ def study(name: str, changes: dict, episodes: int, seed: int) -> None:
     try:
         rng = np.random.default_rng(seed)
         genes = rng.uniform(-1.0, 1.0, size=(20 * episodes, 37))
-        out = evaluate_genes(sim, genes, 2.0, geometry.control_period, DISCARD)
-        upright = out[:, TILT] < DISCARD
+        out = evaluate_genes(sim, genes, 2.0, geometry.control_period, DISCARD_TILT)
+        upright = out[:, TILT] < DISCARD_TILT
         reach = np.hypot(out[:, X], out[:, Y])
         fast = upright & (reach >= np.median(reach[upright]))
         kept = genes[fast]

@@ -51,11 +51,8 @@ from evorbc_ros.nodes.common import (
     finite_parameter,
 )
 from evorbc_ros.robots.hexapod import HEXAPOD
-from sim_bridge.bridge_robots import make_bridge_robot
+from sim_bridge.bridge_robots import bridge_robot_class
 from sim_bridge.maze import load_named_maze
-
-#: Clearance (m) a random start keeps from walls: 4WS robots, the hexapod's legs.
-FOOTPRINT_CLEARANCE = {False: 0.05, True: 0.30}
 
 
 def stamp(seconds: float) -> Time:
@@ -119,9 +116,9 @@ class SimBridgeNode(Node):
             maze = load_named_maze(maze_name)
         except ConfigError as e:
             raise StartupError(f"parameter maze: {e}") from None
-        clearance = FOOTPRINT_CLEARANCE[robot == HEXAPOD]
-        pose = self._start_pose(maze, start, seed, clearance)
-        self.robot = make_bridge_robot(self, robot, maze, pose, episode_time, gui)
+        kind = bridge_robot_class(robot)
+        pose = self._start_pose(maze, start, seed, kind.geometry_type().footprint_radius)
+        self.robot = kind(self, robot, maze, pose, episode_time, gui)
         self.world = self.robot.world
         self.trajectory = [list(self.world.pose)]
         self.fresh = dict.fromkeys(self.robot.command_keys, False)

@@ -17,8 +17,8 @@ from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
 from evorbc_ros.nodes.common import RELIABLE, StartupError, declare, finite_parameter
-from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES
-from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES
+from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES, FourWSGeometry
+from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES, HexapodGeometry
 from sim_bridge.hexapod.maze_world import HexapodMazeWorld
 from sim_bridge.world import LaserConfig, SimWorld
 
@@ -43,6 +43,7 @@ class FourWSBridge:
 
     #: Command topics the lockstep loop waits for each cycle (parameter names).
     command_keys = ("steering", "wheel")
+    geometry_type = FourWSGeometry  # its footprint_radius keeps random starts off walls
 
     def __init__(self, node, robot: str, maze, pose, episode_time: float, gui: bool) -> None:
         self.node = node
@@ -139,6 +140,7 @@ class HexapodBridge:
     """The hexapod: a JointTrajectory of targets per control period, PyBullet dynamics."""
 
     command_keys = ("trajectory",)
+    geometry_type = HexapodGeometry
 
     def __init__(self, node, robot: str, maze, pose, episode_time: float, gui: bool) -> None:
         self.node = node
@@ -203,8 +205,7 @@ class HexapodBridge:
     def advance(self) -> None:
         """One control period through the latest trajectory (held once it is used up)."""
         self.world.step(self.trajectory)
-        if self.trajectory is not None:
-            self.trajectory = self.trajectory[-1:]  # hold the last target until the next
+        self.trajectory = None  # used up: the world holds its last target until the next
 
     def scan(self) -> np.ndarray:
         """Laser ranges (m), float32 as LaserScan carries them."""
@@ -234,9 +235,8 @@ class HexapodBridge:
         msg.effort = tau.tolist()
 
 
-def make_bridge_robot(node, robot: str, maze, pose, episode_time: float, gui: bool):
-    """The adapter for ``robot``."""
+def bridge_robot_class(robot: str) -> type[FourWSBridge] | type[HexapodBridge]:
+    """The adapter class for ``robot``."""
     if robot not in ROBOTS:
         raise StartupError(f"parameter robot must be one of {', '.join(ROBOTS)}")
-    kind = HexapodBridge if robot == HEXAPOD else FourWSBridge
-    return kind(node, robot, maze, pose, episode_time, gui)
+    return HexapodBridge if robot == HEXAPOD else FourWSBridge

@@ -9,7 +9,8 @@ from neat_helpers import neat_config, network_spec, random_genomes
 
 from evorbc_ros.mapping import MappingFunction, nearest_brute_force
 from evorbc_ros.network import NetworkSpec, NodeSpec
-from offline_evolution.maze_task.hexapod_task import FOOTPRINT_RADIUS, HexapodMazeTask
+from evorbc_ros.robots.hexapod import HexapodGeometry
+from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
 from offline_evolution.maze_task.task import MazeTaskSettings, eq5_fitness
 from sim_bridge.maze import load_named_maze
 
@@ -29,6 +30,9 @@ def task(workers):
 def networks(n_outputs, n=3, seed=0):
     config = neat_config(6, n_outputs, path="config/neat/hexapod.ini")
     return [network_spec(g, config) for g in random_genomes(config, n, seed=seed)]
+
+
+FOOTPRINT_RADIUS = HexapodGeometry().footprint_radius  # about 0.31 m
 
 
 def test_start_poses_keep_the_legs_clear_of_the_walls():

@@ -97,6 +97,18 @@ class HexapodGeometry:
         return np.array([[x, y], [0.0, y], [-x, y], [x, -y], [0.0, -y], [-x, -y]])
 
     @property
+    def footprint_radius(self) -> float:
+        """Radius (m) of the circle about the body centre that holds every foot.
+
+        Feet in the neutral pose (A = B = 0: femur level, shin vertical), foot sphere
+        included; start poses keep this circle clear of walls.
+        """
+        yaw = np.radians(self.leg_yaw_deg)
+        reach = self.coxa_length + self.femur_length  # m, hip to foot in the ground plane
+        feet = self.hip_positions() + reach * np.column_stack([np.cos(yaw), np.sin(yaw)])
+        return float(np.hypot(feet[:, 0], feet[:, 1]).max()) + self.foot_radius
+
+    @property
     def total_mass(self) -> float:
         """kg, body and six legs."""
         return self.body_mass + 6.0 * (self.coxa_mass + self.femur_mass + self.tibia_mass)

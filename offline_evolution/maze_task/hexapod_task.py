@@ -13,7 +13,7 @@ import numpy as np
 from evorbc_ros.config import config_dir
 from evorbc_ros.network import NetworkSpec
 from evorbc_ros.repertoire import Repertoire
-from evorbc_ros.robots.hexapod import HEXAPOD, N_PARAMETERS, HexapodGeometry, parameter_specs
+from evorbc_ros.robots.hexapod import N_PARAMETERS, HexapodGeometry, parameter_specs
 from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.sensors import SensorLayout
 from offline_evolution.maze_task.hexapod_episode import (
@@ -26,10 +26,6 @@ from sim_bridge.hexapod.physics import PhysicsSettings
 from sim_bridge.hexapod.pool import SpawnedWorkers, available_cores, ignore_sigint
 from sim_bridge.maze import load_named_maze
 from sim_bridge.robots.base import control_steps
-
-#: Radius (m) of a circle around the body centre that holds the hexapod's feet in the
-#: neutral pose (front feet at about (0.22, 0.20) m): start poses keep it clear of walls.
-FOOTPRINT_RADIUS = 0.30
 
 _runner: EpisodeRunner | None = None
 
@@ -52,8 +48,6 @@ def _episode(job) -> dict:
 class HexapodMazeTask(SpawnedWorkers):
     """The maze task for the hexapod (``config/tasks/maze-hexapod.yaml``)."""
 
-    robot_name = HEXAPOD
-
     def __init__(
         self,
         settings: MazeTaskSettings,
@@ -74,8 +68,6 @@ class HexapodMazeTask(SpawnedWorkers):
             tuple(self.mazes), self.layout, self.geometry, self.physics, self.n_cycles
         )
         self.workers = max(1, workers or available_cores())
-        self._executor = None
-        self._local: EpisodeRunner | None = None
 
     @property
     def n_mazes(self) -> int:
@@ -96,7 +88,9 @@ class HexapodMazeTask(SpawnedWorkers):
         """``(n_mazes * samples_per_maze, 4)`` rows ``(maze, x, y, heading)``."""
         rows = []
         for k, maze in enumerate(self.mazes):
-            poses = maze.sample_starts(rng, self.settings.samples_per_maze, FOOTPRINT_RADIUS)
+            poses = maze.sample_starts(
+                rng, self.settings.samples_per_maze, self.geometry.footprint_radius
+            )
             rows += [(k, *p) for p in poses]
         return np.array(rows, dtype=np.float64)
 

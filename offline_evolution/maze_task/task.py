@@ -220,8 +220,6 @@ class MazeTask:
 
     # -- the interface shared with the hexapod's task ------------------------------
 
-    robot_name = property(lambda self: self.robot.name)
-
     @property
     def parameter_specs(self) -> tuple:
         """The robot's locomotion parameters (a standard controller's outputs)."""

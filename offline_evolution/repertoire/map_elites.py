@@ -176,13 +176,15 @@ class MapElites:
                 "initial_batch": s.initial_batch,
                 "batch_size": s.batch_size,
                 "iterations": s.iterations,
-                "mutation_probability": s.mutation_probability,
-                "mutation_sigma": s.mutation_sigma,
                 "variation": s.variation,
+                # only the operator that ran: its own settings
                 **(
                     {"iso_sigma": s.iso_sigma, "line_sigma": s.line_sigma}
                     if s.variation == "iso_line_dd"
-                    else {}
+                    else {
+                        "mutation_probability": s.mutation_probability,
+                        "mutation_sigma": s.mutation_sigma,
+                    }
                 ),
                 "evaluations": self.evaluations,
                 "discarded": self.discarded,

@@ -106,8 +106,6 @@ class EvaluationPool(SpawnedWorkers):
         self.geometry = geometry
         self.physics = physics
         self.workers = max(1, workers or available_cores())
-        self._executor = None
-        self._local: HexapodSim | None = None
 
     def evaluate(
         self, genes: np.ndarray, eval_time: float, control_period: float, max_tilt: float
