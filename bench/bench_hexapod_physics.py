@@ -28,7 +28,17 @@ T = 2.0
 PERIOD = 0.1
 NO_EARLY_STOP = math.radians(180.0)  # run every primitive the full T to compare endpoints
 DISCARD = math.radians(45.0)
-CANDIDATES = [(50, 50), (60, 40), (60, 50), (70, 50), (80, 30), (100, 30), (100, 50), (200, 50)]
+CANDIDATES = [
+    (50, 50),
+    (60, 30),
+    (60, 40),
+    (60, 50),
+    (70, 50),
+    (80, 30),
+    (100, 30),
+    (100, 50),
+    (200, 50),
+]
 
 
 def run(genes: np.ndarray, rate: float, iterations: int) -> tuple[np.ndarray, float]:

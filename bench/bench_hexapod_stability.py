@@ -10,7 +10,7 @@ walkers), and counts falls (tilt past 90 deg):
 * switching to a random kept primitive every control cycle for 30 s;
 * switching every 1 s for 30 s.
 
-    python bench/bench_hexapod_stability.py [--episodes 30] [--seed 0]
+    python bench/bench_hexapod_stability.py [--episodes 30] [--seed 0] [--only NAME]
 """
 
 from __future__ import annotations
@@ -25,19 +25,23 @@ from sim_bridge.hexapod.maze_world import FALLEN_TILT
 from sim_bridge.hexapod.physics import HexapodSim
 from sim_bridge.robots.hexapod import DISCARD_TILT
 
+#: The first design (fast servos, long shins); the other variants change it.
+FIRST = {"max_joint_velocity": 10.0, "tibia_length": 0.14}
 VARIANTS = {
-    "current (coxa 0.06, tibia 0.14)": {},
-    "coxa 0.10": {"coxa_length": 0.10},
-    "tibia 0.10": {"tibia_length": 0.10},
-    "coxa 0.10, tibia 0.11": {"coxa_length": 0.10, "tibia_length": 0.11},
+    "first (10 rad/s, coxa 0.06, tibia 0.14)": FIRST,
+    "coxa 0.10": {**FIRST, "coxa_length": 0.10},
+    "tibia 0.10": {**FIRST, "tibia_length": 0.10},
+    "coxa 0.10, tibia 0.11": {**FIRST, "coxa_length": 0.10, "tibia_length": 0.11},
     "coxa 0.10, tibia 0.11, femur 0.10": {
+        **FIRST,
         "coxa_length": 0.10,
         "tibia_length": 0.11,
         "femur_length": 0.10,
     },
-    "servos 5 rad/s": {"max_joint_velocity": 5.0},
-    "servos 5 rad/s, tibia 0.10": {"max_joint_velocity": 5.0, "tibia_length": 0.10},
+    "servos 5 rad/s": {**FIRST, "max_joint_velocity": 5.0},
+    "current (servos 5 rad/s, tibia 0.10)": {},
     "servos 1.5 N m, tibia 0.10": {
+        **FIRST,
         "coxa_torque": 1.5,
         "femur_torque": 1.5,
         "tibia_torque": 1.5,
@@ -91,9 +95,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--episodes", type=int, default=30)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--only", help="run only the variants whose name contains this")
     args = parser.parse_args()
     for name, changes in VARIANTS.items():
-        study(name, changes, args.episodes, args.seed)
+        if args.only is None or args.only in name:
+            study(name, changes, args.episodes, args.seed)
 
 
 if __name__ == "__main__":

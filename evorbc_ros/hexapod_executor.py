@@ -24,6 +24,7 @@ from evorbc_ros.executor import InputWatch
 from evorbc_ros.robots.hexapod import (
     HEXAPOD,
     N_PARAMETERS,
+    SERVO_RATE,
     GaitTable,
     HexapodGeometry,
     gait_step_times,
@@ -47,7 +48,7 @@ class HexapodExecutor(InputWatch):
         self,
         inputs: list[str],
         stale_timeout: float = 0.3,
-        trajectory_rate: float = 60.0,
+        trajectory_rate: float = SERVO_RATE,
         geometry: HexapodGeometry | None = None,
     ):
         super().__init__(HEXAPOD, N_PARAMETERS, inputs, stale_timeout)

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from conftest import small_settings
 
+from evorbc_ros.robots.hexapod import SERVO_RATE
 from offline_evolution.checkpoint import CheckpointError
 from offline_evolution.repertoire.archive import cvt_layout, grid_layout, make_archive
 from offline_evolution.repertoire.emitter import IsoLineDDEmitter, PaperMutationEmitter
@@ -259,7 +260,7 @@ def test_hexapod_run_resumes_to_the_uninterrupted_result(tmp_path):
     settings = load_settings(robot="hexapod", initial_batch=40, batch_size=20, iterations=3, seed=2)
     whole = generate_repertoire(settings, workers=1)
     assert whole.robot == "hexapod" and len(whole) > 10
-    assert whole.algorithm["simulation"]["physics"]["rate_hz"] == 60.0
+    assert whole.algorithm["simulation"]["physics"]["rate_hz"] == SERVO_RATE
     ckpt = tmp_path / "hexapod.checkpoint.npz"
     polls = []
     with pytest.raises(Interrupted):

@@ -15,7 +15,7 @@ from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.hexapod_executor import HexapodExecutor
 from evorbc_ros.nodes.common import vector_message
 from evorbc_ros.nodes.primitive_executor import PrimitiveExecutorNode
-from evorbc_ros.robots.hexapod import JOINT_NAMES, GaitTable
+from evorbc_ros.robots.hexapod import JOINT_NAMES, SERVO_RATE, GaitTable
 from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
 from offline_evolution.maze_task.replay import replay
 from offline_evolution.maze_task.task import MazeTaskSettings
@@ -26,19 +26,20 @@ EPISODE = 4.0  # s: 40 cycles
 
 def test_executor_samples_the_gait_at_the_simulations_step_times():
     genes = np.linspace(-1, 1, 37)
-    ex = HexapodExecutor(["a"], stale_timeout=0.3, trajectory_rate=60.0)
+    ex = HexapodExecutor(["a"], stale_timeout=0.3)
     ex.on_input("a", 0.0)
     ex.on_primitive(genes, 0.0)
     sim = HexapodSim()
+    n = sim.physics.steps(0.1)  # the executor's default rate is the simulation's
     try:
         for cycle in range(4):
             now = cycle * 100_000_000 * 1e-9  # the node's clock: integer ns
             ex.on_input("a", now)
             cmd = ex.command(now)
-            assert not cmd.stopped and cmd.positions.shape == (6, 18)
-            want = GaitTable(genes).joint_targets(sim.step_times(6), np.zeros(6, dtype=int))
+            assert not cmd.stopped and cmd.positions.shape == (n, 18)
+            want = GaitTable(genes).joint_targets(sim.step_times(n), np.zeros(n, dtype=int))
             np.testing.assert_array_equal(cmd.positions, want)  # bit for bit
-            sim.steps_done += 6
+            sim.steps_done += n
     finally:
         sim.close()
     # stale input: hold the last target, one point
@@ -114,12 +115,15 @@ def test_executor_node_sends_a_period_of_targets_and_holds_on_stale_input(ros):
     rf.publish(vector_message([0.0] * 5))
     gs.publish(vector_message([0.5]))
     prim.publish(vector_message(genes))
-    assert ros.spin_until(lambda: got and len(got[-1].points) == 6)
+    points = round(0.1 * SERVO_RATE)  # one per physics step of the 0.1 s period
+    assert ros.spin_until(lambda: got and len(got[-1].points) == points)
     msg = got[-1]
-    assert list(msg.joint_names) == list(JOINT_NAMES) and len(msg.points) == 6
+    assert list(msg.joint_names) == list(JOINT_NAMES) and len(msg.points) == points
     steps = [p.time_from_start.sec + 1e-9 * p.time_from_start.nanosec for p in msg.points]
-    np.testing.assert_allclose(steps, np.arange(6) / 60.0, atol=1e-9)
-    want = GaitTable(genes).joint_targets(np.arange(6) / 60.0, np.zeros(6, dtype=int))
+    np.testing.assert_allclose(steps, np.arange(points) / SERVO_RATE, atol=1e-9)
+    want = GaitTable(genes).joint_targets(
+        np.arange(points) / SERVO_RATE, np.zeros(points, dtype=int)
+    )
     np.testing.assert_array_equal([p.positions for p in msg.points], want)
     assert not node.stopped_reason
     # Nothing new for more than 0.3 s: the legs hold their last targets.
@@ -162,8 +166,9 @@ def test_bridge_skips_malformed_trajectories_and_holds_the_last_targets():
             ),
         ]
         bridge._store(good, stored.append)
-        # reordered by joint name; step k at k / 60 s holds the last point due by then
-        np.testing.assert_allclose(bridge.trajectory, [q, q, q, 2 * q, 2 * q, 2 * q])
+        # reordered by joint name; step k at k / 50 s holds the last point due by then
+        assert bridge.dt == pytest.approx(1.0 / 50.0)
+        np.testing.assert_allclose(bridge.trajectory, [q, q, q, 2 * q, 2 * q])
         bad = JointTrajectory(joint_names=list(JOINT_NAMES))
         bad.points = [JointTrajectoryPoint(positions=[math.nan] * 18)]
         bridge._store(bad, stored.append)

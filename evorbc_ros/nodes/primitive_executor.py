@@ -9,7 +9,7 @@ command conventions (reliable):
   rr), and ``wheel_velocity_controller/commands``, the four wheel velocities (rad/s).
 * the hexapod, joint_trajectory_controller (trajectory_msgs/JointTrajectory):
   ``joint_trajectory_controller/joint_trajectory``, the 18 joints' targets (rad) for the
-  next 0.1 s, one point per physics step (``trajectory_rate``, 60 Hz), see
+  next 0.1 s, one point per physics step (``trajectory_rate``, 50 Hz), see
   :mod:`evorbc_ros.hexapod_executor`.
 
 A command goes out at once for every new primitive and at least every 0.1 s (10 Hz). If
@@ -40,7 +40,7 @@ from evorbc_ros.nodes.common import (
     vector_message,
 )
 from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES, FourWSGeometry
-from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES
+from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES, SERVO_RATE
 
 ROBOTS = (*ROBOT_TYPES, HEXAPOD)
 
@@ -90,7 +90,7 @@ class PrimitiveExecutorNode(Node):
         rate = finite_parameter(
             self,
             "trajectory_rate",
-            60.0,
+            SERVO_RATE,
             "hexapod trajectory points per second (the simulation's physics rate)",
             positive=True,
         )

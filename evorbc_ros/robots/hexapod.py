@@ -52,13 +52,19 @@ RHO_LOW, RHO_HIGH = math.pi / 8.0, math.pi / 8.0 + 2.0 * math.pi
 #: Number of primitive parameters: rho plus (offset, amplitude, phase) for 12 joints.
 N_PARAMETERS = 1 + 3 * len(EVOLVED_JOINTS)
 
+#: Hz, the servo loop: one joint target per physics step of the simulation
+#: (docs/hexapod.md says why 50), so a 0.1 s control period is 5 targets.
+SERVO_RATE = 50.0
+
 
 @dataclass(frozen=True)
 class HexapodGeometry:
     """Dimensions, masses and actuators of the simulated hexapod (docs/hexapod.md).
 
     The V-REP model the paper used is not published; these are a realistic small hexapod
-    of about 2.5 kg whose servos resemble fast hobby servos (2.5 N m, 0.1 s per 60 deg).
+    of about 2.5 kg whose servos resemble standard hobby servos under load (2.5 N m,
+    0.21 s per 60 deg). The short shin and slow servos keep it upright when the arbitrator
+    switches gaits every cycle (bench/bench_hexapod_stability.py).
     Lengths in m, masses in kg, angles in rad.
     """
 
@@ -68,7 +74,7 @@ class HexapodGeometry:
     body_mass: float = 1.0  # kg
     coxa_length: float = 0.06  # m, hip (A) axis to femur (B) axis
     femur_length: float = 0.085  # m, B axis to C axis
-    tibia_length: float = 0.14  # m, C axis to the centre of the foot sphere
+    tibia_length: float = 0.10  # m, C axis to the centre of the foot sphere
     coxa_mass: float = 0.05  # kg
     femur_mass: float = 0.08  # kg
     tibia_mass: float = 0.12  # kg
@@ -82,7 +88,7 @@ class HexapodGeometry:
     coxa_torque: float = 2.5  # N m, largest torque the A servo applies
     femur_torque: float = 2.5  # N m, B servo
     tibia_torque: float = 2.5  # N m, C servo
-    max_joint_velocity: float = 10.0  # rad/s (0.1 s per 60 deg, a fast hobby servo)
+    max_joint_velocity: float = 5.0  # rad/s (0.21 s per 60 deg)
     position_gain: float = 20.0  # 1/s, commanded joint velocity per rad of error
     frequency: float = 1.0  # Hz, omega of eq. 10 (paper Appendix D)
     control_period: float = 0.1  # s, the arbitrator's cycle

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as p
 
-from evorbc_ros.robots.hexapod import HexapodGeometry, gait_step_times
+from evorbc_ros.robots.hexapod import SERVO_RATE, HexapodGeometry, gait_step_times
 from sim_bridge.hexapod.urdf import hexapod_urdf
 
 #: Collision groups: laser rays see only walls; the robot touches ground and walls.
@@ -36,7 +36,7 @@ WALL_GROUP, ROBOT_GROUP, GROUND_GROUP = 1, 2, 4
 class PhysicsSettings:
     """How the hexapod is simulated (docs/hexapod.md records why these values)."""
 
-    rate: float = 60.0  # Hz, physics steps per second (the servo loop runs at this rate)
+    rate: float = SERVO_RATE  # Hz, physics steps per second (the servo loop runs at this rate)
     solver_iterations: int = 50  # Bullet's constraint solver iterations per step
     friction: float = 1.0  # lateral friction of feet, body, ground and walls
     settle_time: float = 1.0  # s, holding the neutral pose before the rest state is saved
