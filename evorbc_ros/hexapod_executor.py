@@ -1,10 +1,13 @@
 """What the primitive executor commands a hexapod (pure code).
 
 A hexapod primitive is a gait (eq. 10-11): joint targets that change continuously. Every
-command covers the next control period with one trajectory point per physics step
-(``dt = 1 / trajectory_rate`` s), the targets of :class:`~evorbc_ros.robots.hexapod.GaitTable`
-sampled at the gait time of each step, so the joints follow the gait smoothly between the
-arbitrator's 10 Hz decisions.
+command is a trajectory with one point per physics step (``dt = 1 / trajectory_rate`` s),
+the targets of :class:`~evorbc_ros.robots.hexapod.GaitTable` sampled at the gait time of
+each step, so the joints follow the gait smoothly between the arbitrator's 10 Hz
+decisions. It covers ``horizon`` s ahead (by default the stale timeout, 0.3 s, three
+control periods): the next command replaces it after one period, and a late one finds the
+legs still walking rather than frozen mid-stride. A controller that reaches the end of a
+trajectory holds its last point, so the robot stops by itself if the executor dies.
 
 The gait clock starts with the first primitive and counts whole physics steps,
 ``round((now - t0) / dt)``: a new primitive takes over at the current phase of the
@@ -36,7 +39,7 @@ class JointTargets:
     """One command for the hexapod: joint targets at evenly spaced times."""
 
     positions: np.ndarray  # (points, 18) rad, JOINT_NAMES order
-    dt: float  # s between points; point k applies from k * dt after the command
+    dt: float  # s between points; point k is the target from k * dt after the command on
     stopped: bool  # True when this is the safety stop (one point: hold)
     reason: str = ""
 
@@ -50,14 +53,20 @@ class HexapodExecutor(InputWatch):
         stale_timeout: float = 0.3,
         trajectory_rate: float = SERVO_RATE,
         geometry: HexapodGeometry | None = None,
+        horizon: float | None = None,
     ):
         super().__init__(HEXAPOD, N_PARAMETERS, inputs, stale_timeout)
         self.geometry = geometry or HexapodGeometry()
         self.dt = 1.0 / trajectory_rate
-        self.points = max(1, round(self.geometry.control_period * trajectory_rate))
+        # s ahead that a command covers: at least one control period.
+        horizon = max(self.geometry.control_period, stale_timeout if horizon is None else horizon)
+        self.points = max(1, round(horizon * trajectory_rate))
         self.gait_start: float | None = None  # clock time (s) of the first primitive
         self.table: GaitTable | None = None
-        self.held = self.geometry.neutral_pose()  # (18,) rad, last target sent
+        # The last trajectory sent and the clock time (s) it was sent at; a stop holds the
+        # point that was being tracked then.
+        self.sent = self.geometry.neutral_pose()[None, :]  # (points, 18) rad
+        self.sent_at = 0.0
 
     def on_primitive(self, genes, now: float) -> None:
         """A new primitive; the gait clock starts with the first one."""
@@ -71,11 +80,13 @@ class HexapodExecutor(InputWatch):
         return round((now - self.gait_start) / self.dt)
 
     def command(self, now: float) -> JointTargets:
-        """Targets for the next control period from ``now``, or a hold if stopped."""
+        """Targets for the next ``horizon`` s from ``now``, or a hold if stopped."""
         reason = self.stop_reason(now)
         if reason:
-            return JointTargets(self.held[None, :].copy(), self.dt, True, reason)
+            k = min(max(round((now - self.sent_at) / self.dt), 0), len(self.sent) - 1)
+            self.sent, self.sent_at = self.sent[k : k + 1].copy(), now
+            return JointTargets(self.sent.copy(), self.dt, True, reason)
         times = gait_step_times(self.gait_step(now), self.points, self.dt)
         positions = self.table.joint_targets(times, np.zeros(self.points, dtype=np.int64))
-        self.held = positions[-1].copy()
-        return JointTargets(positions, self.dt, False)
+        self.sent, self.sent_at = positions, now
+        return JointTargets(positions.copy(), self.dt, False)

@@ -36,3 +36,20 @@ def load_json_file(path: str | os.PathLike, what: str, error: type[Exception]) -
             f"{source}: {kind} {what} file (invalid JSON at line {e.lineno}, "
             f"column {e.colno}: {e.msg})"
         ) from None
+
+
+def first_difference(saved: dict, current: dict, where: str) -> str | None:
+    """Describe the first key whose value differs between a saved record and now.
+
+    Nested dicts are compared key by key, so the message names the innermost setting
+    (``geometry.max_joint_velocity is 10.0 in <where> but 5.0 now``); None if equal.
+    """
+    for key in sorted(set(saved) | set(current)):
+        old, new = saved.get(key), current.get(key)
+        if isinstance(old, dict) and isinstance(new, dict):
+            inner = first_difference(old, new, where)
+            if inner:
+                return f"{key}.{inner}"
+        elif old != new:
+            return f"{key} is {old!r} in {where} but {new!r} now"
+    return None

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write
+from evorbc_ros.json_files import first_difference
 
 _HEADER = "__header__"
 
@@ -61,9 +62,10 @@ def load_checkpoint(path: str | os.PathLike) -> tuple[dict, dict[str, np.ndarray
     return header, arrays
 
 
-def settings_mismatch(saved: dict, current: dict) -> str | None:
-    """Describe the first setting that differs between a checkpoint and this run."""
-    for key in sorted(set(saved) | set(current)):
-        if saved.get(key) != current.get(key):
-            return f"{key} is {saved.get(key)!r} in the checkpoint but {current.get(key)!r} now"
-    return None
+def settings_mismatch(saved: dict, current: dict, where: str = "the checkpoint") -> str | None:
+    """Describe the first setting that differs between a saved run and this one.
+
+    Nested dicts are compared key by key, so the message names the innermost setting
+    (``geometry.max_joint_velocity is 10.0 in the checkpoint but 5.0 now``).
+    """
+    return first_difference(saved, current, where)

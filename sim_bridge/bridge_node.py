@@ -21,8 +21,9 @@ Modes:
   ``lockstep_timeout`` s without commands.
 * ``realtime``: step every 0.1 s of wall time with the latest commands.
 
-The episode ends at the target or after ``episode_time``; the result (reached, time,
-eq. 5 fitness, trajectory) is logged and, if ``result_file`` is set, written as JSON.
+The episode ends at the target, when the hexapod falls over, or after ``episode_time``;
+the result (reached, fell, time, eq. 5 fitness, trajectory) is logged and, if
+``result_file`` is set, written as JSON.
 """
 
 from __future__ import annotations
@@ -143,19 +144,31 @@ class SimBridgeNode(Node):
 
     @staticmethod
     def _start_pose(maze, start: str, seed: int, clearance: float) -> tuple[float, float, float]:
-        if start == "nominal":
-            return maze.start_pose
+        """The start pose; its footprint (``clearance`` m about the centre) must be clear."""
         if start == "random":
-            return tuple(maze.sample_starts(np.random.default_rng(seed), 1, clearance)[0])
-        try:
-            x, y, h = (float(v) for v in start.split(","))
-        except ValueError:
+            try:
+                return tuple(maze.sample_starts(np.random.default_rng(seed), 1, clearance)[0])
+            except ValueError as e:  # a negative seed, or no start in the region fits
+                raise StartupError(f"parameter start random (seed {seed}): {e}") from None
+        if start == "nominal":
+            x, y, h = maze.start_pose
+        else:
+            try:
+                x, y, h = (float(v) for v in start.split(","))
+            except ValueError:
+                raise StartupError(
+                    f"parameter start must be nominal, random or 'x,y,heading_deg', got {start!r}"
+                ) from None
+            if not all(math.isfinite(v) for v in (x, y, h)):
+                raise StartupError(f"parameter start must be finite, got {start!r}")
+            h = math.radians(h)
+        room = maze.clearance(x, y)
+        if room < clearance:
             raise StartupError(
-                f"parameter start must be nominal, random or 'x,y,heading_deg', got {start!r}"
-            ) from None
-        if not all(math.isfinite(v) for v in (x, y, h)):
-            raise StartupError(f"parameter start must be finite, got {start!r}")
-        return x, y, math.radians(h)
+                f"parameter start: ({x:.2f}, {y:.2f}) m is {room:.3f} m from a wall of maze "
+                f"{maze.name}, but the robot needs {clearance:.3f} m"
+            )
+        return x, y, h
 
     # -- commands ----------------------------------------------------------------------
 
@@ -311,6 +324,7 @@ class SimBridgeNode(Node):
             "maze": self.world.maze.name,
             "robot": self.robot.name,
             "reached": s.reached,
+            "fell": s.fell,
             "time": round(s.time, 3),
             "fitness": s.fitness,
             "final_distance": s.distance,
@@ -323,15 +337,21 @@ class SimBridgeNode(Node):
             if self.loop_start is None
             else (time.monotonic() - self.loop_start),
         }
-        verdict = (
-            f"reached the target in {s.time:.1f} s"
-            if s.reached
-            else (f"did not reach the target ({s.distance:.2f} m left after {s.time:.1f} s)")
-        )
+        verdict = episode_verdict(result)
         self.get_logger().info(f"{verdict}; fitness {s.fitness:.3f}")
         if self.result_file:
             atomic_write_text(self.result_file, json.dumps(result))
         return result
+
+
+def episode_verdict(result: dict) -> str:
+    """One phrase for a result: reached, fell over, or where the time ran out."""
+    if result["reached"]:
+        return f"reached the target in {result['time']:.1f} s"
+    left = f"{result['final_distance']:.2f} m left"
+    if result.get("fell"):
+        return f"fell over after {result['time']:.1f} s ({left})"
+    return f"did not reach the target ({left} after {result['time']:.1f} s)"
 
 
 def main(argv=None) -> int:

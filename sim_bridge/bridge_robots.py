@@ -151,7 +151,10 @@ class HexapodBridge:
             "joint trajectory command topic",
         )
         self.world = HexapodMazeWorld(maze, pose, episode_time, gui)
+        # The latest trajectory resampled at the physics steps, and the next step to run:
+        # a trajectory longer than a period keeps the legs walking until the next arrives.
         self.trajectory: np.ndarray | None = None
+        self.cursor = 0
         s = self.world.scanner
         self.scan_geometry = ScanGeometry(
             s.angle_min, s.angle_max, s.angle_increment, s.range_min, s.range_max
@@ -176,7 +179,7 @@ class HexapodBridge:
                 f"{self.topic}: {problem}; ignored", throttle_duration_sec=2.0
             )
             return
-        self.trajectory = rows
+        self.trajectory, self.cursor = rows, 0
         on_command("trajectory")
 
     def _targets(self, msg: JointTrajectory) -> tuple[str, np.ndarray | None]:
@@ -197,15 +200,19 @@ class HexapodBridge:
         times = np.asarray(times)
         if np.any(np.diff(times) <= 0):
             return "point times must increase", None
-        # Zero-order hold: physics step k (at k * dt) tracks the last point due by then.
-        steps = self.world.steps_per_period
+        # Zero-order hold: physics step k (at k * dt) tracks the last point due by then,
+        # over the whole span of the trajectory (times in s from receipt).
+        steps = math.ceil(times[-1] / self.dt - 1e-6) + 1  # through the last point's step
         due = np.searchsorted(times, np.arange(steps) * self.dt + 1e-6, side="right") - 1
         return "", np.asarray(rows)[np.clip(due, 0, None)]
 
     def advance(self) -> None:
-        """One control period through the latest trajectory (held once it is used up)."""
-        self.world.step(self.trajectory)
-        self.trajectory = None  # used up: the world holds its last target until the next
+        """One control period along the latest trajectory (its last target held after it)."""
+        rows = None
+        if self.trajectory is not None and self.cursor < len(self.trajectory):
+            rows = self.trajectory[self.cursor : self.cursor + self.world.steps_per_period]
+            self.cursor += self.world.steps_per_period
+        self.world.step(rows)
 
     def scan(self) -> np.ndarray:
         """Laser ranges (m), float32 as LaserScan carries them."""

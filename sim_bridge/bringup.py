@@ -19,12 +19,18 @@ import tempfile
 import time
 from pathlib import Path
 
+from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.config import ConfigError
 from evorbc_ros.defaults import default_arbitrator
-from evorbc_ros.robots.hexapod import HEXAPOD
+from evorbc_ros.json_files import first_difference
+from evorbc_ros.repertoire import RepertoireError
+from evorbc_ros.robots.hexapod import HEXAPOD, HexapodGeometry
+from sim_bridge.bridge_node import episode_verdict
 from sim_bridge.bridge_robots import ROBOTS
+from sim_bridge.hexapod.physics import PhysicsSettings
 from sim_bridge.maze import load_named_maze, maze_names
+from sim_bridge.robots.hexapod import check_simulation, describe_simulation
 
 NODES = {
     "laser_sensor": "evorbc_ros.nodes.laser_sensor",
@@ -56,7 +62,11 @@ def parse_args(argv=None) -> argparse.Namespace:
     p.add_argument(
         "--arbitrator", default="", help="arbitrator file (default: the shipped one for --robot)"
     )
-    p.add_argument("--repertoire", default="", help="its repertoire (default: the shipped one)")
+    p.add_argument(
+        "--repertoire",
+        default="",
+        help="its repertoire (default: the shipped one for the arbitrator's robot)",
+    )
     p.add_argument(
         "--mode",
         choices=("lockstep", "realtime"),
@@ -124,6 +134,27 @@ class Graph:
                 proc.wait()
 
 
+def check_design(controller: Controller) -> None:
+    """Refuse a hexapod controller evolved for another design than the bridge simulates.
+
+    Raises:
+        ConfigError: one line naming the file and the first setting that differs.
+
+    """
+    bridge = describe_simulation(HexapodGeometry(), PhysicsSettings())
+    if controller.repertoire is not None:
+        check_simulation(controller.repertoire, bridge, controller.repertoire_path)
+        return
+    recorded = controller.spec.evolution.get("simulation")
+    mismatch = recorded and first_difference(
+        {"simulation": recorded}, {"simulation": bridge}, "the controller"
+    )
+    if mismatch:
+        raise ConfigError(
+            f"{controller.arbitrator_path}: was evolved for a different robot ({mismatch})"
+        )
+
+
 def main(argv=None) -> int:
     """Run one episode through the graph; 0 if it ran (reached or not), 1 on errors."""
     args = parse_args(argv)
@@ -132,11 +163,18 @@ def main(argv=None) -> int:
         arb = ArbitratorFile.load(arb_path)
         if args.robot and arb.robot != args.robot:
             raise ConfigError(f"{arb_path}: is for robot {arb.robot}, not --robot {args.robot}")
+        # What the arbitrator node will load, checked here so that a mismatch is one line
+        # rather than a node that exits at start-up.
+        controller = Controller(arb_path, args.repertoire)
+        if arb.robot == HEXAPOD:
+            check_design(controller)
         args.maze = args.maze or ("hexapod" if arb.robot == HEXAPOD else "obstacle")
         maze = load_named_maze(args.maze)
-    except (ConfigError, ArbitratorError) as e:
+    except (ConfigError, ArbitratorError, RepertoireError) as e:
         print(f"evorbc-sim: error: {e}", file=sys.stderr)
         return 1
+    if args.result and Path(args.result).exists():
+        Path(args.result).unlink()  # never report an earlier run's result as this one's
     env = dict(os.environ)
     env.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
     if args.domain_id is not None:
@@ -193,7 +231,7 @@ def main(argv=None) -> int:
             print("\nevorbc-sim: stopping the graph", file=sys.stderr)
         finally:
             graph.stop()
-        if not Path(result_file).exists():
+        if not Path(result_file).exists() or (bridge.returncode != 0 and not interrupted):
             print(
                 "evorbc-sim: error: the simulation bridge ended without a result "
                 f"(status {bridge.returncode})",
@@ -201,11 +239,7 @@ def main(argv=None) -> int:
             )
             return 130 if interrupted else 1
         result = json.loads(Path(result_file).read_text())
-    verdict = (
-        f"reached the target in {result['time']:.1f} s"
-        if result["reached"]
-        else f"did not reach the target, {result['final_distance']:.2f} m left"
-    )
+    verdict = episode_verdict(result)
     print(f"{maze.name}: {verdict}, fitness {result['fitness']:.3f} ({args.mode}) -> {plot}")
     from sim_bridge.maze_plot import plot_run
 

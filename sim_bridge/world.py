@@ -61,11 +61,12 @@ class EpisodeStatus:
     distance: float  # m, robot centre to target
     initial_distance: float  # m
     episode_time: float  # s, T of eq. 5
+    fell: bool = False  # the hexapod's body tilted past 90 deg: the episode ends there
 
     @property
     def done(self) -> bool:
-        """Target reached or time up."""
-        return self.reached or self.time >= self.episode_time - 1e-9
+        """Target reached, robot fallen over, or time up."""
+        return self.reached or self.fell or self.time >= self.episode_time - 1e-9
 
     @property
     def fitness(self) -> float:

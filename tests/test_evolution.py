@@ -88,6 +88,21 @@ def test_checkpoint_of_another_run_is_refused(tmp_path, small_neat_file, small_r
         evolve(s, small_repertoire, checkpoint=ckpt)
 
 
+def test_checkpoint_for_another_robot_design_is_refused(
+    tmp_path, small_neat_file, small_repertoire
+):
+    ckpt = tmp_path / "c.json"
+    s = settings(small_neat_file, repertoire=small_repertoire)
+    with pytest.raises(Interrupted):
+        evolve(s, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    data = json.loads(ckpt.read_text())
+    assert data["simulation"] is None  # the 4WS kinematics: nothing to record
+    data["simulation"] = {"geometry": {"max_joint_velocity": 10.0}}
+    ckpt.write_text(json.dumps(data))
+    with pytest.raises(CheckpointError, match=r"different robot .*simulation"):
+        evolve(s, small_repertoire, checkpoint=ckpt)
+
+
 def test_standard_neat_drives_the_parameters(small_neat_file):
     result = evolve(settings(small_neat_file, kind="standard", generations=3), None)
     assert len(result.best_network.output_keys) == 5  # speed and four wheel angles

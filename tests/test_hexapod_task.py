@@ -120,3 +120,16 @@ def test_the_primitive_nearest_the_mapped_point_drives_the_robot(repertoire):
     dx, dy = r.pose[0, -1, :2] - (x0, y0)
     local = (dx * math.cos(h0) + dy * math.sin(h0), -dx * math.sin(h0) + dy * math.cos(h0))
     np.testing.assert_allclose(local, repertoire.behaviour[chosen], atol=0.1)
+
+
+def test_a_laser_layout_no_laserscan_can_hold_is_named_at_once(tmp_path):
+    from evorbc_ros.config import ConfigError
+
+    path = tmp_path / "uneven.yaml"
+    path.write_text(
+        "rangefinders:\n  angles_deg: [-75, -30, 0, 37.5, 75]\n  range: 2.0\n"
+        "  mount_radius: 0.0\n  field_of_view_deg: 30\n  rays: 5\ngoal_bearing: true\n"
+    )
+    settings = MazeTaskSettings(("hexapod",), EPISODE, 1, str(path))
+    with pytest.raises(ConfigError, match=f"{path}: the layout's rays are not evenly spaced"):
+        HexapodMazeTask(settings, workers=2)

@@ -5,7 +5,7 @@ import pytest
 from conftest import small_settings
 
 from evorbc_ros.robots.hexapod import SERVO_RATE
-from offline_evolution.checkpoint import CheckpointError
+from offline_evolution.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
 from offline_evolution.repertoire.archive import cvt_layout, grid_layout, make_archive
 from offline_evolution.repertoire.emitter import IsoLineDDEmitter, PaperMutationEmitter
 from offline_evolution.repertoire.map_elites import (
@@ -148,6 +148,18 @@ def test_checkpoint_of_another_run_is_refused(tmp_path):
         generate_repertoire(small_settings(seed=9), checkpoint=ckpt)
     ckpt.write_bytes(ckpt.read_bytes()[:100])
     with pytest.raises(CheckpointError, match="not a usable checkpoint"):
+        generate_repertoire(small_settings(), checkpoint=ckpt)
+
+
+def test_checkpoint_for_another_robot_design_is_refused(tmp_path):
+    ckpt = tmp_path / "c.npz"
+    run = MapElites(small_settings())
+    run.step()
+    run.save(ckpt)
+    header, arrays = load_checkpoint(ckpt)
+    header["simulation"] = {"geometry": {"tibia_length": 0.14}}
+    save_checkpoint(ckpt, header, arrays)
+    with pytest.raises(CheckpointError, match=r"different robot .*simulation is"):
         generate_repertoire(small_settings(), checkpoint=ckpt)
 
 

@@ -36,16 +36,31 @@ def test_executor_samples_the_gait_at_the_simulations_step_times():
             now = cycle * 100_000_000 * 1e-9  # the node's clock: integer ns
             ex.on_input("a", now)
             cmd = ex.command(now)
-            assert not cmd.stopped and cmd.positions.shape == (n, 18)
+            assert not cmd.stopped and cmd.positions.shape == (3 * n, 18)
             want = GaitTable(genes).joint_targets(sim.step_times(n), np.zeros(n, dtype=int))
-            np.testing.assert_array_equal(cmd.positions, want)  # bit for bit
+            np.testing.assert_array_equal(cmd.positions[:n], want)  # bit for bit
             sim.steps_done += n
     finally:
         sim.close()
-    # stale input: hold the last target, one point
-    held = ex.command(10.0)
+    # A command covers the stale timeout ahead (0.3 s), so a late one finds the legs walking.
+    assert len(cmd.positions) == round(0.3 * SERVO_RATE)
+    # Input "a" last came at 0.3 s; at 0.62 s it is stale: hold the point that was being
+    # tracked, 0.32 s into the command sent at 0.3 s (past its end: its last point).
+    held = ex.command(0.62)
     assert held.stopped and "stale" in held.reason
     np.testing.assert_array_equal(held.positions, cmd.positions[-1:])
+    assert ex.command(0.7).positions.tolist() == held.positions.tolist()  # and keep it
+
+
+def test_executor_holds_the_point_being_tracked_when_an_input_goes_stale():
+    ex = HexapodExecutor(["a"], stale_timeout=0.3)
+    ex.on_input("a", 0.0)
+    ex.on_primitive(np.linspace(-1, 1, 37), 0.0)
+    ex.on_primitive(np.linspace(-1, 1, 37), 0.2)  # primitives keep coming, "a" does not
+    cmd = ex.command(0.2)
+    held = ex.command(0.36)  # "a" is 0.36 s old; the command sent at 0.2 s is at point 8
+    assert held.stopped
+    np.testing.assert_array_equal(held.positions, cmd.positions[8:9])
 
 
 @pytest.fixture(scope="module")
@@ -106,7 +121,7 @@ def test_lockstep_graph_reproduces_the_offline_episode(tmp_path, controller):
     assert np.hypot(*(trajectory[-1, :2] - trajectory[0, :2])) > 0.2  # it walked
 
 
-def test_executor_node_sends_a_period_of_targets_and_holds_on_stale_input(ros):
+def test_executor_node_sends_the_stale_timeout_ahead_and_holds_on_stale_input(ros):
     node = ros.make(PrimitiveExecutorNode, sim_time=True, robot="hexapod")
     got = ros.listen(JointTrajectory, "joint_trajectory_controller/joint_trajectory")
     prim, rf, gs = ros.executor_inputs()
@@ -115,7 +130,7 @@ def test_executor_node_sends_a_period_of_targets_and_holds_on_stale_input(ros):
     rf.publish(vector_message([0.0] * 5))
     gs.publish(vector_message([0.5]))
     prim.publish(vector_message(genes))
-    points = round(0.1 * SERVO_RATE)  # one per physics step of the 0.1 s period
+    points = round(0.3 * SERVO_RATE)  # one per physics step of the 0.3 s stale timeout
     assert ros.spin_until(lambda: got and len(got[-1].points) == points)
     msg = got[-1]
     assert list(msg.joint_names) == list(JOINT_NAMES) and len(msg.points) == points
@@ -126,7 +141,8 @@ def test_executor_node_sends_a_period_of_targets_and_holds_on_stale_input(ros):
     )
     np.testing.assert_array_equal([p.positions for p in msg.points], want)
     assert not node.stopped_reason
-    # Nothing new for more than 0.3 s: the legs hold their last targets.
+    # Nothing new for more than 0.3 s: the legs hold the trajectory's end, where a
+    # controller following it stands by then.
     ros.set_clock(2.5)
     assert ros.spin_until(lambda: node.stopped_reason != "")
     assert ros.spin_until(lambda: len(got[-1].points) == 1)
@@ -166,9 +182,10 @@ def test_bridge_skips_malformed_trajectories_and_holds_the_last_targets():
             ),
         ]
         bridge._store(good, stored.append)
-        # reordered by joint name; step k at k / 50 s holds the last point due by then
+        # reordered by joint name; step k at k / 50 s holds the last point due by then,
+        # through the step that reaches the last point (0.06 s)
         assert bridge.dt == pytest.approx(1.0 / 50.0)
-        np.testing.assert_allclose(bridge.trajectory, [q, q, q, 2 * q, 2 * q])
+        np.testing.assert_allclose(bridge.trajectory, [q, q, q, 2 * q])
         bad = JointTrajectory(joint_names=list(JOINT_NAMES))
         bad.points = [JointTrajectoryPoint(positions=[math.nan] * 18)]
         bridge._store(bad, stored.append)
@@ -177,8 +194,56 @@ def test_bridge_skips_malformed_trajectories_and_holds_the_last_targets():
         assert "finite" in node.warnings[0] and "18 joints" in node.warnings[1]
         bridge.advance()
         np.testing.assert_allclose(bridge.world.targets, 2 * q)
+        # A trajectory of three periods: without a new one the legs walk on through it,
+        # then hold its last point.
+        long = JointTrajectory(joint_names=list(JOINT_NAMES))
+        long.points = [
+            JointTrajectoryPoint(
+                positions=(k * q).tolist(), time_from_start=Duration(nanosec=20_000_000 * k)
+            )
+            for k in range(15)
+        ]
+        bridge._store(long, stored.append)
+        for last in (4, 9, 14, 14):
+            bridge.advance()
+            np.testing.assert_allclose(bridge.world.targets, last * q)
     finally:
         bridge.world.close()
+
+
+def test_evorbc_sim_refuses_a_start_inside_the_legs_reach_and_drops_old_results(
+    tmp_path, controller, capsys
+):
+    from sim_bridge.bringup import main
+
+    arb_path, rep_path, _, _ = controller
+    old = tmp_path / "result.json"
+    old.write_text('{"reached": true}')  # an earlier run's result must not be reported
+    argv = ["--arbitrator", str(arb_path), "--repertoire", str(rep_path), "--quiet"]
+    # The obstacle maze's nominal start is 0.09 m from a wall; the legs reach 0.31 m.
+    assert main([*argv, "--maze", "obstacle", "--result", str(old), "--plot", ""]) == 1
+    assert not old.exists()
+    assert "without a result" in capsys.readouterr().err
+
+
+def test_evorbc_sim_refuses_a_repertoire_of_another_design(tmp_path, controller, capsys):
+    import dataclasses
+
+    from evorbc_ros.repertoire import Repertoire
+    from sim_bridge.bringup import main
+
+    arb_path, rep_path, _, _ = controller
+    rep = Repertoire.load(rep_path)
+    simulation = rep.algorithm["simulation"]
+    other = {**simulation, "physics": {**simulation["physics"], "rate_hz": 60.0}}
+    path = tmp_path / "other.json"
+    dataclasses.replace(rep, algorithm={"simulation": other}).save(path)
+    assert main(["--arbitrator", str(arb_path), "--repertoire", str(path)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"evorbc-sim: error: {path}: was evolved for a different robot "
+        "(simulation.physics.rate_hz is 60.0 in the repertoire but 50.0 now)"
+    ]
 
 
 def test_evorbc_sim_refuses_an_arbitrator_for_another_robot(capsys):

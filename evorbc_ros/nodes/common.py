@@ -103,11 +103,27 @@ def run_node(make: Callable[[], Node], argv: Sequence[str] | None = None) -> int
     return 0
 
 
-def declare(node: Node, name: str, default, description: str):
-    """Declare a parameter with a description and return its value."""
-    from rcl_interfaces.msg import ParameterDescriptor
+def declare(node: Node, name: str, default, description: str, any_type: bool = False):
+    """Declare a parameter with a description and return its value.
 
-    return node.declare_parameter(name, default, ParameterDescriptor(description=description)).value
+    Args:
+        any_type: accept an override of any type (the caller checks it), so that
+            ``-p rate:=100`` reaches a float parameter as an int instead of failing.
+
+    Raises:
+        StartupError: the override has another type than ``default``.
+    """
+    from rcl_interfaces.msg import ParameterDescriptor
+    from rclpy.exceptions import InvalidParameterTypeException
+
+    descriptor = ParameterDescriptor(description=description, dynamic_typing=any_type)
+    try:
+        return node.declare_parameter(name, default, descriptor).value
+    except InvalidParameterTypeException:
+        kind = {bool: "true or false", int: "an integer", float: "a number", str: "a string"}
+        raise StartupError(
+            f"parameter {name} must be {kind.get(type(default), type(default).__name__)}"
+        ) from None
 
 
 def load_sensor_layout(path: str):
@@ -136,8 +152,9 @@ def finite_parameter(
     """Declare a float parameter and check it is finite (and > 0 if ``positive``)."""
     import math
 
-    value = declare(node, name, float(default), description)
-    if not isinstance(value, (int, float)) or not math.isfinite(value) or (positive and value <= 0):
+    value = declare(node, name, float(default), description, any_type=True)
+    number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if not number or not math.isfinite(value) or (positive and value <= 0):
         need = "a positive number" if positive else "a finite number"
         raise StartupError(f"parameter {name} must be {need}, got {value!r}")
     return float(value)

@@ -9,10 +9,11 @@ command conventions (reliable):
   rr), and ``wheel_velocity_controller/commands``, the four wheel velocities (rad/s).
 * the hexapod, joint_trajectory_controller (trajectory_msgs/JointTrajectory):
   ``joint_trajectory_controller/joint_trajectory``, the 18 joints' targets (rad) for the
-  next 0.1 s, one point per physics step (``trajectory_rate``, 50 Hz), see
+  next ``stale_timeout`` s, one point per physics step (``trajectory_rate``, 50 Hz), see
   :mod:`evorbc_ros.hexapod_executor`.
 
-A command goes out at once for every new primitive and at least every 0.1 s (10 Hz). If
+A command goes out at once for every new primitive, and again whenever 1.5 periods
+(0.15 s) pass without one, so the controllers keep receiving 10 Hz commands. If
 the primitive or a sensor input is older than ``stale_timeout`` (0.3 s) the executor
 stops the robot within one cycle (4WS: zero wheel speed, steering held; hexapod: every
 joint held at its last target), and resumes when they return.

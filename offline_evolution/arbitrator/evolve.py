@@ -44,6 +44,7 @@ from offline_evolution.arbitrator.selection import (
 )
 from offline_evolution.checkpoint import CheckpointError, Interrupted, settings_mismatch
 from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings, make_task
+from sim_bridge.robots.hexapod import check_simulation
 
 CHECKPOINT_KIND = "evorbc-neat-checkpoint"
 #: Extra generations that give standard NEAT EvoRBC's budget: the 4WS repertoire costs
@@ -133,6 +134,12 @@ def file_sha256(path: str | os.PathLike) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
+def simulation_of(task) -> dict | None:
+    """What a task simulates (hexapod: geometry and physics), or None (4WS kinematics)."""
+    describe = getattr(task, "describe", None)
+    return describe() if describe is not None else None
+
+
 class Evolution:
     """One NEAT run on the maze task."""
 
@@ -144,9 +151,12 @@ class Evolution:
     ):
         self.settings = settings
         self.task = make_task(MazeTaskSettings(**settings.task), settings.robot, workers)
+        # The simulated robot (PyBullet robots; None for the 4WS kinematics).
+        self.simulation = simulation_of(self.task)
         if settings.kind == "evorbc":
             if repertoire is None:
                 raise ValueError("EvoRBC evolution needs a repertoire")
+            check_simulation(repertoire, self.simulation)
             n_outputs = 2
         else:
             n_outputs = self.task.n_standard_outputs
@@ -251,6 +261,7 @@ class Evolution:
             "hall_of_fame": self.hall.to_dict(),
             "history": [h.as_dict() for h in self.history],
             "elapsed": elapsed,
+            "simulation": self.simulation,
         }
         atomic_write_text(path, json.dumps(data))
 
@@ -269,6 +280,11 @@ class Evolution:
         mismatch = settings_mismatch(data.get("settings", {}), self.settings.as_dict())
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
+        mismatch = settings_mismatch(
+            {"simulation": data.get("simulation")}, {"simulation": self.simulation}
+        )
+        if mismatch:
+            raise CheckpointError(f"{path}: was written for a different robot ({mismatch})")
         try:
             self.population = population_from_dict(data["population"], self.config)
             self.best = data["best"]
@@ -353,6 +369,9 @@ def arbitrator_file(
         "task": s.task,
         "history": [h.as_dict() for h in result.history],
     }
+    simulation = simulation_of(task)
+    if simulation is not None:
+        evolution["simulation"] = simulation  # the robot the controller was evolved on
     if s.kind == "evorbc":
         return ArbitratorFile(
             kind="evorbc",

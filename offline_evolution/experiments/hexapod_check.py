@@ -9,7 +9,8 @@ through the CLI, so every run is a command a user can repeat:
 Then reports, next to the paper's values: the repertoire's size, quality and left/right
 symmetry; EvoRBC's best fitness (mean +- sd), how many runs reached the goal and the first
 generation that did; how far standard NEAT got (eq. 5 fitness, 1 - d_final/d_initial when
-it does not arrive); and how often the selected arbitrator switches primitive.
+it does not arrive, and how far along the maze its controller walks); and how often the
+selected arbitrator switches primitive.
 
 Every run checkpoints each generation and resumes when the experiment is started again;
 finished runs are skipped.
@@ -21,17 +22,16 @@ Run: ``python -m offline_evolution.experiments.hexapod_check --repertoire REP.js
 from __future__ import annotations
 
 import argparse
-import json
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from evorbc_ros.arbitrator import ArbitratorFile
+from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.config import build_settings
-from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.repertoire import Repertoire, RepertoireError
 from offline_evolution.repertoire.stats import repertoire_stats
 
 PAPER = {
@@ -44,10 +44,20 @@ PAPER = {
 
 
 def cli(*args: str) -> None:
-    """Run ``evorbc-evolve`` with ``args`` (it resumes from its own checkpoint)."""
+    """Run ``evorbc-evolve`` with ``args`` (it resumes from its own checkpoint).
+
+    Raises:
+        SystemExit: the command failed (its own one-line error is above).
+
+    """
     cmd = [sys.executable, "-m", "offline_evolution.cli", *args]
     print("$ evorbc-evolve " + " ".join(args), flush=True)
-    subprocess.run(cmd, check=True)
+    code = subprocess.run(cmd, check=False).returncode
+    if code != 0:
+        raise SystemExit(
+            f"hexapod_check: error: evorbc-evolve {args[0]} exited with status {code}; "
+            "finished runs are kept and the same command resumes"
+        )
 
 
 def run_all(repertoire: Path, out: Path, seeds: list[int], standard_seeds: list[int]) -> None:
@@ -73,21 +83,36 @@ def run_all(repertoire: Path, out: Path, seeds: list[int], standard_seeds: list[
             )  # fmt: skip
 
 
-def replay_switches(arbitrator: Path, repertoire: Path) -> tuple[float, bool, float]:
-    """Primitive switches per cycle, reached, and fitness from the maze's nominal start."""
+def replay_nominal(arbitrator: Path, repertoire: Path | None) -> dict:
+    """Replay a controller from the maze's nominal start.
+
+    Returns:
+        ``switches_per_cycle``, ``reached``, ``fitness``, and ``progress``: the share of
+        the start-to-goal span along the maze's length (x) that the robot covered.
+
+    """
     from offline_evolution.maze_task.replay import replay
     from offline_evolution.maze_task.task import MazeTaskSettings, make_task
 
     arb = ArbitratorFile.load(arbitrator)
-    rep = Repertoire.load(repertoire)
+    rep = Repertoire.load(repertoire) if arb.kind == "evorbc" else None
     settings = build_settings(MazeTaskSettings, arb.evolution["task"], f"{arbitrator}: task")
     task = make_task(settings, arb.robot, workers=1)
     try:
-        outcomes, _ = replay(arb, task, task.nominal_starts(), rep)
+        starts = task.nominal_starts()
+        outcomes, result = replay(arb, task, starts, rep)
+        target_x = task.mazes[0].target[0]
     finally:
         task.close()
     o = outcomes[0]
-    return o.switches_per_cycle, o.reached, o.fitness
+    final_x = result.pose[0, int(result.cycles[0]), 0]
+    start_x = starts[0, 1]
+    return {
+        "switches_per_cycle": o.switches_per_cycle,
+        "reached": o.reached,
+        "fitness": o.fitness,
+        "progress": (final_x - start_x) / (target_x - start_x),
+    }
 
 
 def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: list[int]) -> str:
@@ -125,8 +150,7 @@ def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: lis
         for k in seeds:
             path = out / f"evorbc-seed{k}.json"
             if path.exists():
-                per_cycle, _, _ = replay_switches(path, repertoire)
-                switches.append(per_cycle)
+                switches.append(replay_nominal(path, repertoire)["switches_per_cycle"])
         rate = np.mean(switches)
         lines.append(
             f"| primitive switches of the selected arbitrators (nominal start) | "
@@ -138,11 +162,21 @@ def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: lis
     std = [e for e in std if e is not None]
     if std:
         best = np.array([e["best_fitness"] for e in std])
+        walks = [
+            replay_nominal(out / f"standard-seed{k}.json", None)
+            for k in standard_seeds
+            if (out / f"standard-seed{k}.json").exists()
+        ]
+        how_far = ", ".join(
+            "reached the goal" if w["reached"] else f"{100 * w['progress']:.0f} % of the way"
+            for w in walks
+        )
         lines.append(
-            f"| standard NEAT best fitness, {len(std)} run(s) of {std[0]['generations']} "
-            f"generations | {best.mean():.2f}: covered {100 * best.mean():.0f} % of the "
-            f"straight-line distance to the goal, goal reached in "
-            f"{sum(e['best_reached'] >= 1 for e in std)} of {len(std)} | {PAPER['standard']} |"
+            f"| standard NEAT, {len(std)} run(s) of {std[0]['generations']} generations | "
+            f"best fitness {best.mean():.2f}, goal reached in "
+            f"{sum(e['best_reached'] >= 1 for e in std)} of {len(std)} in training; the "
+            f"selected controller from the nominal start: {how_far} along the maze | "
+            f"{PAPER['standard']} |"
         )
     text = "\n".join(lines) + "\n"
     atomic_write_text(out / "hexapod-check.md", text)
@@ -150,7 +184,8 @@ def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: lis
 
 
 def _evolution(path: Path) -> dict | None:
-    return json.loads(path.read_text())["evolution"] if path.exists() else None
+    """The ``evolution`` record of a finished run's file, or None if not run yet."""
+    return ArbitratorFile.load(path).evolution if path.exists() else None
 
 
 def main() -> None:
@@ -162,12 +197,18 @@ def main() -> None:
     parser.add_argument("--standard-seeds", type=int, default=1, help="standard-NEAT runs")
     parser.add_argument("--summarise-only", action="store_true")
     args = parser.parse_args()
-    args.out.mkdir(parents=True, exist_ok=True)
-    seeds = list(range(1, args.seeds + 1))
-    standard = list(range(1, args.standard_seeds + 1))
-    if not args.summarise_only:
-        run_all(args.repertoire, args.out, seeds, standard)
-    print(summarise(args.repertoire, args.out, seeds, standard))
+    try:
+        rep = Repertoire.load(args.repertoire)
+        if rep.robot != "hexapod":
+            raise RepertoireError(f"{args.repertoire}: is for robot {rep.robot}, not hexapod")
+        args.out.mkdir(parents=True, exist_ok=True)
+        seeds = list(range(1, args.seeds + 1))
+        standard = list(range(1, args.standard_seeds + 1))
+        if not args.summarise_only:
+            run_all(args.repertoire, args.out, seeds, standard)
+        print(summarise(args.repertoire, args.out, seeds, standard))
+    except (RepertoireError, ArbitratorError, OSError) as e:
+        raise SystemExit(f"hexapod_check: error: {e}") from None
 
 
 if __name__ == "__main__":

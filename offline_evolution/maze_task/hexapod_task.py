@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from evorbc_ros.config import config_dir
+from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.network import NetworkSpec
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.hexapod import N_PARAMETERS, HexapodGeometry, parameter_specs
@@ -24,8 +24,10 @@ from offline_evolution.maze_task.hexapod_episode import (
 from offline_evolution.maze_task.task import EpisodeResult, MazeTaskSettings, eq5_fitness
 from sim_bridge.hexapod.physics import PhysicsSettings
 from sim_bridge.hexapod.pool import SpawnedWorkers, available_cores, ignore_sigint
+from sim_bridge.hexapod.scanner import Scanner
 from sim_bridge.maze import load_named_maze
 from sim_bridge.robots.base import control_steps
+from sim_bridge.robots.hexapod import describe_simulation
 
 _runner: EpisodeRunner | None = None
 
@@ -61,13 +63,21 @@ class HexapodMazeTask(SpawnedWorkers):
         self.mazes = [load_named_maze(name) for name in settings.mazes]
         self.layout = SensorLayout.load(config_dir() / settings.sensors)
         if self.layout.rangefinders is None:
-            raise ValueError(f"{settings.sensors}: the hexapod's laser needs rangefinders")
+            raise ConfigError(f"{settings.sensors}: the hexapod's laser needs rangefinders")
+        try:  # here, not first in a worker, so that the error names the file
+            Scanner.from_layout(self.layout.rangefinders)
+        except ValueError as e:
+            raise ConfigError(f"{settings.sensors}: {e}") from None
         self.dt = self.geometry.control_period
         self.n_cycles = control_steps(settings.episode_time, self.dt)
         self.world = HexapodWorld(
             tuple(self.mazes), self.layout, self.geometry, self.physics, self.n_cycles
         )
         self.workers = max(1, workers or available_cores())
+
+    def describe(self) -> dict:
+        """The simulated robot (geometry and physics), as repertoire files record it."""
+        return describe_simulation(self.geometry, self.physics)
 
     @property
     def n_mazes(self) -> int:

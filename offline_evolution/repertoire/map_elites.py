@@ -209,6 +209,8 @@ class MapElites:
             "evaluations": self.evaluations,
             "discarded": self.discarded,
             "emitter": self.emitter.get_state(),
+            # The simulated robot (PyBullet robots): another design cannot resume this run.
+            "simulation": self._simulation().get("simulation"),
         }
         arrays = {k: elites[k] for k in ("solution", "objective", "measures", *EXTRA_FIELDS)}
         if "centroids" in self.layout:
@@ -228,6 +230,12 @@ class MapElites:
         mismatch = settings_mismatch(header.get("settings", {}), self.settings.as_dict())
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
+        mismatch = settings_mismatch(
+            {"simulation": header.get("simulation")},
+            {"simulation": self._simulation().get("simulation")},
+        )
+        if mismatch:
+            raise CheckpointError(f"{path}: was written for a different robot ({mismatch})")
         if "centroids" in self.layout and not np.array_equal(
             arrays.get("centroids"), np.asarray(self.layout["centroids"])
         ):

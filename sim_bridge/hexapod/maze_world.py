@@ -84,10 +84,10 @@ class HexapodMazeWorld:
 
         """
         if trajectory is not None and len(trajectory):
-            self.targets = np.asarray(trajectory[-1], dtype=np.float64)
             rows = np.asarray(trajectory, dtype=np.float64)[: self.steps_per_period]
         else:
             rows = self.targets[None, :]
+        self.targets = rows[-1].copy()  # the servos hold the last target they tracked
         pad = self.steps_per_period - len(rows)
         rows = np.vstack([rows, np.repeat(rows[-1:], pad, axis=0)]) if pad > 0 else rows
         tilt, _ = self.sim.run(rows, max_tilt=FALLEN_TILT)
@@ -102,10 +102,18 @@ class HexapodMazeWorld:
         return self.scanner.scan(self.sim)
 
     def status(self) -> EpisodeStatus:
-        """Time, distance to the target and whether it was reached (a fall ends it)."""
-        time = self.episode_time if self.fell else self.time
+        """Time, distance to the target, and whether it was reached or the robot fell.
+
+        Reaching the target counts first when both happen in one cycle, as offline; a
+        fall ends the episode and eq. 5 scores where the robot lies.
+        """
         return EpisodeStatus(
-            time, self.reached, self._distance(), self.initial_distance, self.episode_time
+            self.time,
+            self.reached,
+            self._distance(),
+            self.initial_distance,
+            self.episode_time,
+            fell=self.fell and not self.reached,
         )
 
     def close(self) -> None:

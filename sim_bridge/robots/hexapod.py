@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
+import json
+
 import numpy as np
 
+from evorbc_ros.json_files import first_difference
+from evorbc_ros.repertoire import Repertoire, RepertoireError
 from evorbc_ros.robots.hexapod import HEXAPOD, N_PARAMETERS, HexapodGeometry, parameter_specs
 from evorbc_ros.robots.primitive import ParameterSpec
 from sim_bridge.hexapod.evaluate import HEADING, PATH, TILT, X, Y
@@ -18,6 +23,38 @@ SPEED_BOUND = 0.6
 
 #: Tilt (rad) beyond which an evaluation stops: eq. 6 discards the primitive anyway.
 DISCARD_TILT = np.radians(45.0)
+
+
+def describe_simulation(geometry: HexapodGeometry, physics: PhysicsSettings) -> dict:
+    """Plain-data description of a simulated hexapod: its geometry and physics settings.
+
+    Repertoires, checkpoints and arbitrator files record it, so that a file made for
+    another design (other servos, legs or physics rate) is refused rather than reused.
+    """
+    described = {"geometry": dataclasses.asdict(geometry), "physics": physics.as_dict()}
+    return json.loads(json.dumps(described))  # as a file holds it: tuples become lists
+
+
+def check_simulation(
+    repertoire: Repertoire, simulation: dict | None, source: str = "the repertoire"
+) -> None:
+    """Refuse a repertoire evolved for another simulated robot than ``simulation``.
+
+    A repertoire that records no simulation (made by hand, or for the 4WS kinematics)
+    passes: there is nothing to compare.
+
+    Raises:
+        RepertoireError: one line naming ``source`` and the first setting that differs.
+
+    """
+    recorded = repertoire.algorithm.get("simulation")
+    if recorded is None:
+        return
+    mismatch = first_difference(
+        {"simulation": recorded}, {"simulation": simulation}, "the repertoire"
+    )
+    if mismatch:
+        raise RepertoireError(f"{source}: was evolved for a different robot ({mismatch})")
 
 
 class HexapodRobot:
@@ -68,9 +105,7 @@ class HexapodRobot:
 
     def describe(self) -> dict:
         """Plain-data description of the simulated robot (recorded in repertoire files)."""
-        import dataclasses
-
-        return {"geometry": dataclasses.asdict(self.geometry), "physics": self.physics.as_dict()}
+        return describe_simulation(self.geometry, self.physics)
 
     def close(self) -> None:
         """Stop the worker processes."""

@@ -1,0 +1,53 @@
+"""Files record the simulated robot they were made for; another design is refused."""
+
+import dataclasses
+
+import pytest
+from hexapod_helpers import tripod_repertoire
+
+from offline_evolution.checkpoint import settings_mismatch
+from offline_evolution.cli import main
+
+
+def test_mismatch_names_the_innermost_setting():
+    saved = {"seed": 1, "simulation": {"geometry": {"tibia_length": 0.14, "foot": 0.012}}}
+    now = {"seed": 1, "simulation": {"geometry": {"tibia_length": 0.10, "foot": 0.012}}}
+    assert settings_mismatch(saved, now, "the repertoire") == (
+        "simulation.geometry.tibia_length is 0.14 in the repertoire but 0.1 now"
+    )
+    assert settings_mismatch(saved, saved) is None
+
+
+def test_arbitrator_cli_refuses_a_hexapod_repertoire_of_another_design(tmp_path, capsys):
+    rep = tripod_repertoire()
+    geometry = rep.algorithm["simulation"]["geometry"]
+    first_design = {**geometry, "max_joint_velocity": 10.0}
+    rep = dataclasses.replace(
+        rep, algorithm={"simulation": {**rep.algorithm["simulation"], "geometry": first_design}}
+    )
+    path = tmp_path / "old.json"
+    rep.save(path)
+    out = tmp_path / "arb.json"
+    code = main(["arbitrator", "--repertoire", str(path), "--generations", "1", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code != 0 and not out.exists()
+    assert err == [
+        f"evorbc-evolve: error: {path}: was evolved for a different robot "
+        "(simulation.geometry.max_joint_velocity is 10.0 in the repertoire but 5.0 now)"
+    ]
+
+
+def test_a_repertoire_of_this_design_is_accepted():
+    from offline_evolution.arbitrator.evolve import check_simulation, simulation_of
+    from offline_evolution.arbitrator.settings import load_run_settings
+    from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+
+    task = make_task(
+        MazeTaskSettings.load(load_run_settings(robot="hexapod").task_path()), "hexapod", 1
+    )
+    try:
+        check_simulation(tripod_repertoire(), simulation_of(task), "rep.json")  # no error
+    finally:
+        task.close()
+    with pytest.raises(ValueError, match=r"rep\.json: was evolved for a different robot"):
+        check_simulation(tripod_repertoire(), {"geometry": {}}, "rep.json")
