@@ -57,8 +57,8 @@ def throughput(n: int, workers: int | None) -> None:
     rate = n / wall
     print(f"machine: {machine()}; physics: {robot.describe()}")
     print(
-        f"{n} random primitives of {settings.eval_time:g} s on {robot.workers} worker(s): "
-        f"{wall:.1f} s = {rate:.1f} evaluations/s ({1e3 / rate * robot.workers:.1f} ms each "
+        f"{n} random primitives of {settings.eval_time:g} s on {robot.pool.workers} worker(s): "
+        f"{wall:.1f} s = {rate:.1f} evaluations/s ({1e3 / rate * robot.pool.workers:.1f} ms each "
         f"per core); full Table I ({settings.evaluations:,} evaluations) projected "
         f"{settings.evaluations / rate / 3600:.2f} h"
     )

@@ -1,12 +1,12 @@
 """Bring up the simulated graph: sim_bridge and the four evorbc nodes.
 
     ros2 launch evorbc_ros sim.launch.py maze:=zigzag mode:=lockstep gui:=false
-    ros2 launch evorbc_ros sim.launch.py robot:=hexapod
+    ros2 launch evorbc_ros sim.launch.py robot:=hexapod arbitrator:=ARB.json repertoire:=REP.json
 
 Arguments: robot (4ws-5 or another 4WS type, or hexapod), maze (default: obstacle, or
 hexapod for the hexapod), mode (lockstep|realtime), gui, arbitrator and repertoire
-(files; empty for the shipped ones). Node parameters come from config/ros/*.yaml of the
-package; the hexapod's episode is 30 s.
+(files; empty for the shipped ones, which exist for 4ws-5 only so far). Node parameters
+come from config/ros/*.yaml of the package; the hexapod's episode is 30 s.
 The same graph starts without ROS 2's launch via ``evorbc-sim``.
 """
 

@@ -69,3 +69,18 @@ def settings_mismatch(saved: dict, current: dict, where: str = "the checkpoint")
     (``geometry.max_joint_velocity is 10.0 in the checkpoint but 5.0 now``).
     """
     return first_difference(saved, current, where)
+
+
+def check_same_robot(path: str | os.PathLike, saved: dict | None, current: dict | None) -> None:
+    """Refuse a checkpoint written for another simulated robot (geometry, physics).
+
+    Unlike a repertoire, a checkpoint that records none only matches a run that has none
+    (the 4WS kinematics): checkpoints of the first hexapod design recorded nothing.
+
+    Raises:
+        CheckpointError: naming the file and the first setting that differs.
+
+    """
+    mismatch = settings_mismatch({"simulation": saved}, {"simulation": current})
+    if mismatch:
+        raise CheckpointError(f"{path}: was written for a different robot ({mismatch})")

@@ -20,17 +20,16 @@ import time
 from pathlib import Path
 
 from evorbc_ros.arbitration import Controller
-from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
+from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.config import ConfigError
 from evorbc_ros.defaults import default_arbitrator
-from evorbc_ros.json_files import first_difference
 from evorbc_ros.repertoire import RepertoireError
 from evorbc_ros.robots.hexapod import HEXAPOD, HexapodGeometry
 from sim_bridge.bridge_node import episode_verdict
 from sim_bridge.bridge_robots import ROBOTS
 from sim_bridge.hexapod.physics import PhysicsSettings
 from sim_bridge.maze import load_named_maze, maze_names
-from sim_bridge.robots.hexapod import check_simulation, describe_simulation
+from sim_bridge.robots.hexapod import check_simulation, describe_simulation, simulation_mismatch
 
 NODES = {
     "laser_sensor": "evorbc_ros.nodes.laser_sensor",
@@ -51,7 +50,8 @@ def parse_args(argv=None) -> argparse.Namespace:
         "--robot",
         choices=ROBOTS,
         default="",
-        help="robot whose shipped controller runs (default: the arbitrator file's, else 4ws-5)",
+        help="robot whose shipped controller runs (default: the arbitrator file's, else 4ws-5; "
+        "only 4ws-5 ships one so far)",
     )
     p.add_argument(
         "--maze",
@@ -146,9 +146,7 @@ def check_design(controller: Controller) -> None:
         check_simulation(controller.repertoire, bridge, controller.repertoire_path)
         return
     recorded = controller.spec.evolution.get("simulation")
-    mismatch = recorded and first_difference(
-        {"simulation": recorded}, {"simulation": bridge}, "the controller"
-    )
+    mismatch = simulation_mismatch(recorded, bridge, "the controller")
     if mismatch:
         raise ConfigError(
             f"{controller.arbitrator_path}: was evolved for a different robot ({mismatch})"
@@ -160,12 +158,12 @@ def main(argv=None) -> int:
     args = parse_args(argv)
     try:
         arb_path = args.arbitrator or str(default_arbitrator(args.robot or "4ws-5"))
-        arb = ArbitratorFile.load(arb_path)
-        if args.robot and arb.robot != args.robot:
-            raise ConfigError(f"{arb_path}: is for robot {arb.robot}, not --robot {args.robot}")
         # What the arbitrator node will load, checked here so that a mismatch is one line
         # rather than a node that exits at start-up.
         controller = Controller(arb_path, args.repertoire)
+        arb = controller.spec
+        if args.robot and arb.robot != args.robot:
+            raise ConfigError(f"{arb_path}: is for robot {arb.robot}, not --robot {args.robot}")
         if arb.robot == HEXAPOD:
             check_design(controller)
         args.maze = args.maze or ("hexapod" if arb.robot == HEXAPOD else "obstacle")

@@ -38,7 +38,7 @@ def test_arbitrator_cli_refuses_a_hexapod_repertoire_of_another_design(tmp_path,
 
 
 def test_a_repertoire_of_this_design_is_accepted():
-    from offline_evolution.arbitrator.evolve import check_simulation, simulation_of
+    from offline_evolution.arbitrator.evolve import check_simulation
     from offline_evolution.arbitrator.settings import load_run_settings
     from offline_evolution.maze_task.task import MazeTaskSettings, make_task
 
@@ -46,7 +46,7 @@ def test_a_repertoire_of_this_design_is_accepted():
         MazeTaskSettings.load(load_run_settings(robot="hexapod").task_path()), "hexapod", 1
     )
     try:
-        check_simulation(tripod_repertoire(), simulation_of(task), "rep.json")  # no error
+        check_simulation(tripod_repertoire(), task.describe(), "rep.json")  # no error
     finally:
         task.close()
     with pytest.raises(ValueError, match=r"rep\.json: was evolved for a different robot"):

@@ -28,7 +28,7 @@ import numpy as np
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.network import ConnectionSpec, NetworkSpec, NodeSpec
-from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.repertoire import Repertoire, RepertoireError
 from offline_evolution.arbitrator.neat_config import load_neat_config
 from offline_evolution.arbitrator.neat_state import (
     genome_from_dict,
@@ -42,7 +42,12 @@ from offline_evolution.arbitrator.selection import (
     post_evaluate,
     post_evaluation_starts,
 )
-from offline_evolution.checkpoint import CheckpointError, Interrupted, settings_mismatch
+from offline_evolution.checkpoint import (
+    CheckpointError,
+    Interrupted,
+    check_same_robot,
+    settings_mismatch,
+)
 from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings, make_task
 from sim_bridge.robots.hexapod import check_simulation
 
@@ -134,12 +139,6 @@ def file_sha256(path: str | os.PathLike) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def simulation_of(task) -> dict | None:
-    """What a task simulates (hexapod: geometry and physics), or None (4WS kinematics)."""
-    describe = getattr(task, "describe", None)
-    return describe() if describe is not None else None
-
-
 class Evolution:
     """One NEAT run on the maze task."""
 
@@ -148,15 +147,20 @@ class Evolution:
         settings: EvolutionSettings,
         repertoire: Repertoire | None = None,
         workers: int | None = None,
+        repertoire_source: str = "the repertoire",
     ):
         self.settings = settings
         self.task = make_task(MazeTaskSettings(**settings.task), settings.robot, workers)
         # The simulated robot (PyBullet robots; None for the 4WS kinematics).
-        self.simulation = simulation_of(self.task)
+        self.simulation = self.task.describe()
         if settings.kind == "evorbc":
             if repertoire is None:
                 raise ValueError("EvoRBC evolution needs a repertoire")
-            check_simulation(repertoire, self.simulation)
+            try:
+                check_simulation(repertoire, self.simulation, repertoire_source)
+            except RepertoireError:
+                self.task.close()
+                raise
             n_outputs = 2
         else:
             n_outputs = self.task.n_standard_outputs
@@ -280,11 +284,7 @@ class Evolution:
         mismatch = settings_mismatch(data.get("settings", {}), self.settings.as_dict())
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
-        mismatch = settings_mismatch(
-            {"simulation": data.get("simulation")}, {"simulation": self.simulation}
-        )
-        if mismatch:
-            raise CheckpointError(f"{path}: was written for a different robot ({mismatch})")
+        check_same_robot(path, data.get("simulation"), self.simulation)
         try:
             self.population = population_from_dict(data["population"], self.config)
             self.best = data["best"]
@@ -306,6 +306,7 @@ def evolve(
     progress: Callable[[GenerationStats, EvolutionSettings], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
     workers: int | None = None,
+    repertoire_source: str = "the repertoire",
 ) -> EvolutionResult:
     """Run NEAT on the maze task to the last generation.
 
@@ -319,8 +320,12 @@ def evolve(
             :class:`~offline_evolution.repertoire.map_elites.Interrupted`.
         workers: processes that run episodes (PyBullet robots; default: every core). The
             result does not depend on it.
+        repertoire_source: how errors name the repertoire (its file).
+
+    Raises:
+        RepertoireError: the repertoire was evolved for another simulated robot.
     """
-    run = Evolution(settings, repertoire, workers)
+    run = Evolution(settings, repertoire, workers, repertoire_source)
     try:
         elapsed = 0.0
         if checkpoint is not None and os.path.exists(checkpoint):
@@ -369,7 +374,7 @@ def arbitrator_file(
         "task": s.task,
         "history": [h.as_dict() for h in result.history],
     }
-    simulation = simulation_of(task)
+    simulation = task.describe()
     if simulation is not None:
         evolution["simulation"] = simulation  # the robot the controller was evolved on
     if s.kind == "evorbc":

@@ -116,10 +116,8 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         EQUAL_BUDGET_GENERATIONS,
         EvolutionSettings,
         arbitrator_file,
-        check_simulation,
         evolve,
         file_sha256,
-        simulation_of,
     )
     from offline_evolution.arbitrator.settings import load_run_settings
     from offline_evolution.maze_task.task import MazeTaskSettings, make_task
@@ -140,13 +138,6 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     task_settings = MazeTaskSettings.load(args.task or run.task_path())
     if not neat_file.exists():
         raise CliError(f"{neat_file}: no such NEAT settings file")
-    if repertoire is not None:
-        # A repertoire of another design (servos, legs, physics) would silently mislead.
-        task = make_task(task_settings, robot, workers=1)
-        try:
-            check_simulation(repertoire, simulation_of(task), args.repertoire)
-        finally:
-            task.close()
     settings = EvolutionSettings(
         kind=args.kind,
         robot=robot,
@@ -178,6 +169,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             progress=_GenerationPrinter(args.quiet, generations),
             should_stop=stop,
             workers=args.workers or None,
+            repertoire_source=args.repertoire if repertoire else "the repertoire",
         )
     except CheckpointError as e:
         raise CliError(f"{e}; use --restart to discard it") from None

@@ -220,6 +220,13 @@ class MazeTask:
 
     # -- the interface shared with the hexapod's task ------------------------------
 
+    def describe(self) -> None:
+        """No simulated design to record: the 4WS robots are kinematic.
+
+        (The hexapod's task returns its geometry and physics.)
+        """
+        return None
+
     @property
     def parameter_specs(self) -> tuple:
         """The robot's locomotion parameters (a standard controller's outputs)."""

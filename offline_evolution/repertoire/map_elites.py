@@ -21,6 +21,7 @@ from evorbc_ros.repertoire import Repertoire
 from offline_evolution.checkpoint import (
     CheckpointError,
     Interrupted,
+    check_same_robot,
     load_checkpoint,
     save_checkpoint,
     settings_mismatch,
@@ -230,12 +231,7 @@ class MapElites:
         mismatch = settings_mismatch(header.get("settings", {}), self.settings.as_dict())
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
-        mismatch = settings_mismatch(
-            {"simulation": header.get("simulation")},
-            {"simulation": self._simulation().get("simulation")},
-        )
-        if mismatch:
-            raise CheckpointError(f"{path}: was written for a different robot ({mismatch})")
+        check_same_robot(path, header.get("simulation"), self._simulation().get("simulation"))
         if "centroids" in self.layout and not np.array_equal(
             arrays.get("centroids"), np.asarray(self.layout["centroids"])
         ):

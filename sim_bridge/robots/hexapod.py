@@ -36,23 +36,28 @@ def describe_simulation(geometry: HexapodGeometry, physics: PhysicsSettings) -> 
     return json.loads(json.dumps(described))  # as a file holds it: tuples become lists
 
 
+def simulation_mismatch(recorded: dict | None, simulation: dict | None, where: str) -> str | None:
+    """The first setting in which a file's ``recorded`` simulation differs from ``simulation``.
+
+    A file that records none (made by hand, or for the 4WS kinematics) passes: there is
+    nothing to compare.
+    """
+    if recorded is None:
+        return None
+    return first_difference({"simulation": recorded}, {"simulation": simulation}, where)
+
+
 def check_simulation(
     repertoire: Repertoire, simulation: dict | None, source: str = "the repertoire"
 ) -> None:
     """Refuse a repertoire evolved for another simulated robot than ``simulation``.
 
-    A repertoire that records no simulation (made by hand, or for the 4WS kinematics)
-    passes: there is nothing to compare.
-
     Raises:
         RepertoireError: one line naming ``source`` and the first setting that differs.
 
     """
-    recorded = repertoire.algorithm.get("simulation")
-    if recorded is None:
-        return
-    mismatch = first_difference(
-        {"simulation": recorded}, {"simulation": simulation}, "the repertoire"
+    mismatch = simulation_mismatch(
+        repertoire.algorithm.get("simulation"), simulation, "the repertoire"
     )
     if mismatch:
         raise RepertoireError(f"{source}: was evolved for a different robot ({mismatch})")
