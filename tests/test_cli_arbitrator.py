@@ -140,3 +140,27 @@ def test_bad_neat_settings_are_named(tmp_path, capsys, small_neat_file):
         capsys, "standard", "--robot", "4ws-5", "--neat-config", bad, "--out", tmp_path / "s.json"
     )
     assert code == 1 and str(bad) in err and "pop_size" in err
+
+
+def test_replay_over_many_random_starts_reports_each_maze(evolved, capsys):
+    out, _, _, _ = evolved
+    code, stdout, err = run(
+        capsys, "replay", "--arbitrator", out, "--start", "random", "--episodes", 3, "--json"
+    )
+    assert code == 0, err
+    report = json.loads(stdout)
+    assert [m["maze"] for m in report["mazes"]] == ["obstacle"] * 3 + ["gaps"] * 3
+    assert len({tuple(m["start"]) for m in report["mazes"]}) == 6  # distinct starts
+    per_maze = {row["maze"]: row for row in report["per_maze"]}
+    for name in ("obstacle", "gaps"):
+        episodes = [m for m in report["mazes"] if m["maze"] == name]
+        row = per_maze[name]
+        assert row["episodes"] == 3 and row["fell"] == 0  # wheeled robots do not fall
+        assert row["reached"] == sum(m["reached"] for m in episodes)
+        assert row["mean_fitness"] == pytest.approx(sum(m["fitness"] for m in episodes) / 3)
+    code, stdout, _ = run(
+        capsys, "replay", "--arbitrator", out, "--start", "random", "--episodes", 3
+    )
+    assert code == 0 and "random starts per maze" in stdout and "mean time reached" in stdout
+    code, _, err = run(capsys, "replay", "--arbitrator", out, "--episodes", 3)
+    assert code == 1 and "--start random" in err and len(err.splitlines()) == 1

@@ -49,6 +49,14 @@ def add_parsers(sub) -> None:
         help="each maze's nominal start pose, or a random one from --seed",
     )
     p.add_argument("--seed", type=count, default=0, metavar="N", help="seed of random starts")
+    p.add_argument(
+        "--episodes",
+        type=count,
+        default=1,
+        metavar="N",
+        help="with --start random: N random starts per maze, reported per maze as how "
+        "many reached the target or fell and the mean fitness (how robust the controller is)",
+    )
     p.add_argument("--plot", metavar="FILE.png", help="draw the trajectories")
     p.add_argument(
         "--heatmap",
@@ -95,10 +103,12 @@ def resolve_repertoire(
 
 def cmd_replay(args: argparse.Namespace) -> int:
     """Replay and report; optionally draw trajectories and the selection heatmap."""
-    from offline_evolution.maze_task.replay import replay
+    from offline_evolution.maze_task.replay import replay, summarise_outcomes
     from offline_evolution.maze_task.task import MazeTaskSettings, make_task
 
     arb_path = Path(args.arbitrator)
+    if args.episodes < 1 or (args.episodes > 1 and args.start != "random"):
+        raise CliError("--episodes N needs N >= 1, and N > 1 needs --start random")
     arb = ArbitratorFile.load(arb_path)
     repertoire, rep_path, warnings = None, None, []
     if arb.kind == "evorbc":
@@ -124,7 +134,10 @@ def cmd_replay(args: argparse.Namespace) -> int:
         except ArbitratorError as e:
             raise CliError(str(e)) from None
         if args.start == "random":
-            starts = task.sample_starts(np.random.default_rng(args.seed))
+            rng = np.random.default_rng(args.seed)
+            starts = np.concatenate([task.sample_starts(rng) for _ in range(args.episodes)])
+            # maze-major, so each maze's episodes are together in the report
+            starts = starts[np.argsort(starts[:, 0], kind="stable")]
         else:
             starts = task.nominal_starts()
         check_writable(args.plot, args.heatmap)
@@ -133,6 +146,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
         task.close()
     mean = float(np.mean([o.fitness for o in outcomes]))
     reached = sum(o.reached for o in outcomes)
+    summary = summarise_outcomes(outcomes)
     if args.json:
         print(
             json.dumps(
@@ -145,6 +159,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
                     "mazes": [o.as_dict() for o in outcomes],
                     "mean_fitness": mean,
                     "reached": reached,
+                    "per_maze": summary,
                 },
                 indent=1,
             )
@@ -158,12 +173,15 @@ def cmd_replay(args: argparse.Namespace) -> int:
                 else ""
             )
         )
-        print(f"{'maze':<12} {'reached':>7} {'time (s)':>9} {'fitness':>8}")
-        for o in outcomes:
+        if args.episodes == 1:
+            _print_episodes(outcomes)
+            print(f"mean fitness {mean:.3f}, target reached in {reached} of {len(outcomes)} mazes")
+        else:
+            _print_summary(summary)
             print(
-                f"{o.maze:<12} {'yes' if o.reached else 'no':>7} {o.time:>9.1f} {o.fitness:>8.3f}"
+                f"mean fitness {mean:.3f}, target reached in {reached} of {len(outcomes)} "
+                f"episodes ({args.episodes} random starts per maze, seed {args.seed})"
             )
-        print(f"mean fitness {mean:.3f}, target reached in {reached} of {len(outcomes)} mazes")
     if args.plot:
         from offline_evolution.plots.replay import plot_trajectories
 
@@ -175,3 +193,25 @@ def cmd_replay(args: argparse.Namespace) -> int:
 
         plot_selection(repertoire, arb.mapping, result, args.heatmap, title=arb_path.name)
     return 0
+
+
+def _print_episodes(outcomes) -> None:
+    """One line per episode: reached, time and fitness."""
+    print(f"{'maze':<12} {'reached':>7} {'time (s)':>9} {'fitness':>8}")
+    for o in outcomes:
+        status = "yes" if o.reached else ("fell" if o.fell else "no")
+        print(f"{o.maze:<12} {status:>7} {o.time:>9.1f} {o.fitness:>8.3f}")
+
+
+def _print_summary(summary: list[dict]) -> None:
+    """One line per maze over its episodes."""
+    print(
+        f"{'maze':<12} {'episodes':>8} {'reached':>7} {'fell':>5} {'mean fitness':>12} "
+        f"{'mean time reached (s)':>21}"
+    )
+    for row in summary:
+        t = row["mean_time_reached"]
+        print(
+            f"{row['maze']:<12} {row['episodes']:>8} {row['reached']:>7} {row['fell']:>5} "
+            f"{row['mean_fitness']:>12.3f} {'-' if t is None else f'{t:.1f}':>21}"
+        )

@@ -22,6 +22,7 @@ class MazeOutcome:
     final_distance: float  # m, to the target
     start: tuple[float, float, float]  # x m, y m, heading rad
     switches_per_cycle: float  # how often the chosen primitive changed (EvoRBC)
+    fell: bool = False  # the robot fell over (legged robots), which ended the episode
 
     def as_dict(self) -> dict:
         """Plain-data form (``replay --json``)."""
@@ -33,6 +34,7 @@ class MazeOutcome:
             "final_distance": self.final_distance,
             "start": list(self.start),
             "switches_per_cycle": self.switches_per_cycle,
+            "fell": self.fell,
         }
 
 
@@ -59,6 +61,32 @@ def replay(
                 final_distance=float(result.final_distance[e]),
                 start=(float(row[1]), float(row[2]), float(row[3])),
                 switches_per_cycle=switches if arbitrator.kind == "evorbc" else 0.0,
+                fell=bool(result.fell[e]) if result.fell is not None else False,
             )
         )
     return outcomes, result
+
+
+def summarise_outcomes(outcomes: list[MazeOutcome]) -> list[dict]:
+    """Per-maze figures over several episodes, mazes in first-seen order.
+
+    Each row: episodes, how many reached the target and how many fell, the mean fitness and
+    the mean time (s) of the episodes that reached the target (None if none did).
+    """
+    by_maze: dict[str, list[MazeOutcome]] = {}
+    for o in outcomes:
+        by_maze.setdefault(o.maze, []).append(o)
+    rows = []
+    for maze, group in by_maze.items():
+        times = [o.time for o in group if o.reached]
+        rows.append(
+            {
+                "maze": maze,
+                "episodes": len(group),
+                "reached": sum(o.reached for o in group),
+                "fell": sum(o.fell for o in group),
+                "mean_fitness": float(np.mean([o.fitness for o in group])),
+                "mean_time_reached": float(np.mean(times)) if times else None,
+            }
+        )
+    return rows
