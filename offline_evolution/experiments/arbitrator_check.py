@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import mannwhitneyu
 
+from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.arbitrator.evolve import (
@@ -38,6 +39,10 @@ from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
 
 METHODS = ("evorbc", "standard")
+
+#: Random starts per maze, and their seed, for the per-maze robustness table.
+ROBUST_EPISODES = 20
+ROBUST_SEED = 100
 
 
 def run_one(robot: str, kind: str, seed: int, generations: int, runs: Path) -> dict:
@@ -141,9 +146,62 @@ def summarise(robots, seeds, generations, runs: Path, out: Path) -> str:
             out / f"arbitrator-check-{robot}.png",
             title=f"{robot}: highest fitness so far",
         )
+    lines += ["", *per_maze_table(robots, seeds, runs)]
     text = "\n".join(lines) + "\n"
     atomic_write_text(out / "arbitrator-check.md", text)
     return text
+
+
+def per_maze_table(robots, seeds, runs: Path) -> list[str]:
+    """Markdown: each run's selected controller over random starts, per maze.
+
+    Every controller runs from ``ROBUST_EPISODES`` random starts per maze (seed
+    ``ROBUST_SEED``, apart from training and post-evaluation); a cell is the mean eq. 5
+    fitness over the seeds' controllers and, in brackets, the share of episodes that
+    reached the target.
+    """
+    from offline_evolution.maze_task.replay import replay
+
+    header = None
+    rows = []
+    for robot in robots:
+        task_settings = MazeTaskSettings.load(load_run_settings(robot=robot).task_path())
+        task = MazeTask(task_settings, robot)
+        rng = np.random.default_rng(ROBUST_SEED)
+        starts = np.concatenate([task.sample_starts(rng) for _ in range(ROBUST_EPISODES)])
+        names = [m.name for m in task.mazes]
+        header = header or names
+        for kind in METHODS:
+            fitness = np.zeros((len(seeds), len(names)))
+            reached = np.zeros_like(fitness)
+            for i, seed in enumerate(seeds):
+                arb = ArbitratorFile.load(runs / f"{robot}-{kind}-seed{seed}.json")
+                rep = (
+                    Repertoire.load(runs / f"{robot}-repertoire-seed{seed}.json")
+                    if kind == "evorbc"
+                    else None
+                )
+                outcomes, _ = replay(arb, task, starts, rep)
+                for k, name in enumerate(names):
+                    mine = [o for o in outcomes if o.maze == name]
+                    fitness[i, k] = np.mean([o.fitness for o in mine])
+                    reached[i, k] = np.mean([o.reached for o in mine])
+            means = zip(fitness.mean(0), reached.mean(0), strict=True)
+            cells = [f"{f:.2f} ({r:.0%})" for f, r in means]
+            name = "EvoRBC" if kind == "evorbc" else "standard NEAT"
+            rows.append(
+                f"| {robot} | {name} | {' | '.join(cells)} | "
+                f"{fitness.mean():.2f} ({reached.mean():.0%}) |"
+            )
+    return [
+        f"Selected controllers from {ROBUST_EPISODES} random starts per maze (seed "
+        f"{ROBUST_SEED}): mean fitness over the seeds (share of episodes that reached the "
+        "target).",
+        "",
+        f"| robot | method | {' | '.join(header)} | all |",
+        "|---|---|" + "---|" * (len(header) + 1),
+        *rows,
+    ]
 
 
 def main() -> None:
