@@ -160,7 +160,7 @@ def per_maze_table(robots, seeds, runs: Path) -> list[str]:
     fitness over the seeds' controllers and, in brackets, the share of episodes that
     reached the target.
     """
-    from offline_evolution.maze_task.replay import replay
+    from offline_evolution.maze_task.replay import replay, summarise_outcomes
 
     header = None
     rows = []
@@ -182,10 +182,11 @@ def per_maze_table(robots, seeds, runs: Path) -> list[str]:
                     else None
                 )
                 outcomes, _ = replay(arb, task, starts, rep)
+                per_maze = {row["maze"]: row for row in summarise_outcomes(outcomes)}
                 for k, name in enumerate(names):
-                    mine = [o for o in outcomes if o.maze == name]
-                    fitness[i, k] = np.mean([o.fitness for o in mine])
-                    reached[i, k] = np.mean([o.reached for o in mine])
+                    row = per_maze[name]
+                    fitness[i, k] = row["mean_fitness"]
+                    reached[i, k] = row["reached"] / row["episodes"]
             means = zip(fitness.mean(0), reached.mean(0), strict=True)
             cells = [f"{f:.2f} ({r:.0%})" for f, r in means]
             name = "EvoRBC" if kind == "evorbc" else "standard NEAT"
