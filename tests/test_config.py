@@ -64,3 +64,18 @@ def test_missing_key_and_wrong_top_level(tmp_path):
 def test_missing_file(tmp_path):
     with pytest.raises(ConfigError, match="no such settings file"):
         load_settings(tmp_path / "nope.yaml")
+
+
+@pytest.mark.parametrize(
+    "path", sorted((config_dir() / "arbitrator").glob("*.yaml")), ids=lambda p: p.name
+)
+def test_every_shipped_arbitrator_run_file_loads_with_its_task_and_neat_files(path):
+    from offline_evolution.arbitrator.neat_config import load_neat_config
+    from offline_evolution.arbitrator.settings import load_run_settings
+    from offline_evolution.maze_task.task import MazeTaskSettings
+
+    run = load_run_settings(path)
+    task = MazeTaskSettings.load(run.task_path())
+    assert task.samples_per_maze >= 1 and task.episode_time > 0
+    # 6 sensor inputs and the 2 mapping outputs: the same for every family's NEAT file
+    assert load_neat_config(run.neat_path(), 6, 2).pop_size > 0
