@@ -1,0 +1,67 @@
+"""The hexapod paper-check summary: the figures it reports come from the run files."""
+
+import pytest
+from hexapod_helpers import tripod_repertoire
+from neat_helpers import neat_config, network_spec, random_genomes
+
+from evorbc_ros.arbitrator import ArbitratorFile
+from evorbc_ros.config import config_dir
+from evorbc_ros.robots.hexapod import parameter_specs
+from evorbc_ros.sensors import SensorLayout
+from offline_evolution.experiments.hexapod_check import summarise
+
+TASK = {"mazes": ["hexapod"], "episode_time": 2.0, "samples_per_maze": 1,
+        "sensors": "sensors/hexapod.yaml"}  # fmt: skip
+
+
+def evolution(seed, best, first_reach, post_fitness, post_reached):
+    """An ``evolution`` record as the CLI writes it, 10 generations long."""
+    history = [
+        {"generation": g, "best_reached": int(first_reach is not None and g >= first_reach)}
+        for g in range(10)
+    ]
+    return {
+        "seed": seed, "generations": 10, "best_fitness": best, "history": history,
+        "best_reached": int(first_reach is not None), "task": TASK,
+        "post_evaluation": {"fitness": post_fitness, "reached": post_reached,
+                            "episodes_per_candidate": 21},
+    }  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    out = tmp_path_factory.mktemp("check")
+    rep = tripod_repertoire()
+    rep.save(out / "rep.json")
+    layout = SensorLayout.load(config_dir() / "sensors" / "hexapod.yaml")
+    config = neat_config(6, 2, path="config/neat/hexapod.ini")
+    for seed, best, first, post in ((1, 1.2, 6, (0.9, 0.5)), (2, 1.3, None, (0.7, 0.1))):
+        ArbitratorFile(
+            kind="evorbc", robot="hexapod", sensors=layout, mapping="polar",
+            network=network_spec(random_genomes(config, 1, seed=seed)[0], config),
+            repertoire={"fingerprint": rep.fingerprint(), "robot": "hexapod", "count": 6},
+            evolution=evolution(seed, best, first, *post),
+        ).save(out / f"evorbc-seed{seed}.json")  # fmt: skip
+    config37 = neat_config(6, 37, path="config/neat/hexapod.ini")
+    ArbitratorFile(
+        kind="standard", robot="hexapod", sensors=layout, parameters=parameter_specs(),
+        network=network_spec(random_genomes(config37, 1, seed=3)[0], config37),
+        evolution=evolution(1, 0.4, None, 0.3, 0.0),
+    ).save(out / "standard-seed1.json")  # fmt: skip
+    return out
+
+
+def test_summary_reports_the_runs_next_to_the_paper(runs):
+    text = summarise(runs / "rep.json", runs, [1, 2, 3], [1])
+    rows = {line.split(" | ")[0]: line for line in text.splitlines()}
+    assert "| 6 primitives" in rows["| repertoire size"]
+    # seed 3 has not run: the mean and sd are over the two finished runs, and generations
+    # count from 1 as the CLI's progress lines do
+    evo = rows["| EvoRBC best fitness, 2 run(s) of 10 generations"]
+    assert "1.25 ± 0.07; goal reached in 1 of 2; first reached at generation 7, never" in evo
+    post = next(v for k, v in rows.items() if k.startswith("| selected EvoRBC"))
+    assert "seed 1: 0.90, reached 50 % of 21; seed 2: 0.70, reached 10 % of 21" in post
+    assert any(k.startswith("| primitive switches") for k in rows)
+    std = rows["| standard NEAT, 1 run(s) of 10 generations"]
+    assert "best fitness 0.40, goal reached in 0 of 1" in std and "% of the way" in std
+    assert (runs / "hexapod-check.md").read_text() == text
