@@ -14,7 +14,9 @@ nearest its axis, if that beam is within half a beam spacing of it.
 Range values follow REP 117: ``+inf`` is no return within range (nothing seen), ``-inf``
 is an object closer than ``range_min`` (touching), NaN is an invalid measurement (the beam
 is skipped). Finite values below ``range_min`` are invalid; above ``range_max`` they are
-no return.
+no return. A scan whose beams towards a rangefinder are all invalid is refused (the robot
+would walk blind); a rangefinder outside the scan's span reads "nothing seen", and the
+node warns about it once.
 """
 
 from __future__ import annotations
@@ -58,6 +60,20 @@ class LaserToRangefinders:
         self.pose = pose
         self.axes = np.asarray(layout.angles, dtype=np.float64)  # (n,) body frame, rad
 
+    def unseen(self, angle_min: float, angle_increment: float, n_beams: int) -> list[float]:
+        """Axes (deg, body frame) of the rangefinders that a scan with this span never covers.
+
+        They read 0 ("nothing seen") from such a scanner; the arbitrator was evolved with
+        them, so the node warns rather than refusing every scan.
+        """
+        beam = angle_min + angle_increment * np.arange(n_beams)
+        heading = beam + self.pose.yaw
+        direction = np.arctan2(self.pose.y + np.sin(heading), self.pose.x + np.cos(heading))
+        offset = np.abs(_wrap(direction[None, :] - self.axes[:, None]))
+        reach = max(0.5 * self.layout.field_of_view, 0.5 * abs(angle_increment))
+        missed = ~(offset <= reach + ANGLE_TOLERANCE).any(axis=1)
+        return [round(math.degrees(a), 1) for a in self.axes[missed]]
+
     def readings(
         self, angle_min: float, angle_increment: float, ranges, range_min: float, range_max: float
     ) -> np.ndarray:
@@ -65,7 +81,7 @@ class LaserToRangefinders:
 
         Raises:
             InputError: a malformed scan (non-finite or zero increment, non-finite angles or
-                limits, no beams).
+                limits, no beams), or one whose beams towards a rangefinder are all invalid.
         """
         r = np.asarray(ranges, dtype=np.float64)
         for name, value in (
@@ -104,13 +120,29 @@ class LaserToRangefinders:
         # (n_axes, n_beams) angle of each beam from each rangefinder's axis.
         offset = np.abs(_wrap(direction[None, :] - self.axes[:, None]))
         half_fov = 0.5 * self.layout.field_of_view
+        half_gap = 0.5 * abs(angle_increment) + ANGLE_TOLERANCE
         if half_fov > 0.0:
-            members = valid[None, :] & (offset <= half_fov + ANGLE_TOLERANCE)
+            inside = offset <= half_fov + ANGLE_TOLERANCE
+            members = valid[None, :] & inside
+            in_span, usable = inside.any(axis=1), members.any(axis=1)
             nearest = np.where(members, from_mount[None, :], np.inf).min(axis=1)
         else:
             # One ray: the beam nearest the axis (first of equals), if within half a gap.
             candidates = np.where(valid[None, :], offset, np.inf)
             j = np.argmin(candidates, axis=1)
-            close = candidates[np.arange(len(j)), j] <= 0.5 * abs(angle_increment) + ANGLE_TOLERANCE
-            nearest = np.where(close, from_mount[j], np.inf)
+            usable = candidates[np.arange(len(j)), j] <= half_gap
+            in_span = offset.min(axis=1) <= half_gap
+            nearest = np.where(usable, from_mount[j], np.inf)
+        blind = in_span & ~usable
+        if blind.any():
+            # The scanner looks that way but every beam there is invalid: reading it as
+            # "nothing seen" (0) would steer the robot blind. Refuse the scan instead, so the
+            # input goes stale and the executor stops the robot. (Directions the scan does
+            # not span at all read 0, as a fixed property of the scanner; see ``unseen``.)
+            k = int(np.argmax(blind))
+            raise InputError(
+                f"no valid beam for the rangefinder at {math.degrees(self.axes[k]):.1f} deg "
+                f"(body frame): {int(np.isnan(r).sum())} of the scan's {r.size} ranges are "
+                "NaN or below range_min"
+            )
         return np.array([range_reading(float(d), self.layout.max_range) for d in nearest])

@@ -48,6 +48,8 @@ def test_partial_scan_leaves_unseen_directions_empty():
     beams = np.radians(np.arange(-100.0, 130.5, 1.0))
     readings = convert(beams[0], DEG, room_ranges(beams))
     np.testing.assert_allclose(readings, [0.55, 0.55, 0.55, 0.0, 0.0, 0.55], atol=1e-12)
+    unseen = LaserToRangefinders(RF).unseen(beams[0], DEG, beams.size)
+    assert [a % 360 for a in unseen] == [180.0, 240.0]  # the node warns about these once
 
 
 def test_decreasing_increments_give_the_same_readings():
@@ -97,14 +99,37 @@ def test_rep117_values(value, reading, meaning):
     assert convert(beams[0], DEG, ranges)[0] == pytest.approx(reading, abs=1e-12), meaning
 
 
-def test_nan_and_too_close_beams_are_skipped():
+FOV_LAYOUT = SensorLayout.from_dict(
+    {"rangefinders": {"angles_deg": [0, 90], "range": 1.0, "mount_radius": 0.05,
+                      "field_of_view_deg": 30, "rays": 5}}
+).rangefinders  # fmt: skip
+
+
+def test_invalid_beams_are_skipped_when_others_cover_the_rangefinder():
+    beams = np.radians(np.arange(-180.0, 180.0, 1.0))
+    ranges = np.full(beams.size, 0.6)
+    ranges[180] = math.nan  # 0 deg: invalid, skipped
+    ranges[180 + 5] = 0.01  # 5 deg: finite but below range_min, invalid too
+    ranges[180 - 10] = 0.4  # -10 deg: the nearest valid beam
+    readings = LaserToRangefinders(FOV_LAYOUT).readings(beams[0], DEG, ranges, 0.02, 10.0)
+    np.testing.assert_allclose(readings, [1 - 0.35, 1 - 0.55], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("index", "value", "axis"),
+    [(180, math.nan, "0.0"), (240, 0.01, "60.0"), (300, math.nan, "120.0")],
+)
+def test_a_rangefinder_whose_beams_are_all_invalid_refuses_the_scan(index, value, axis):
+    # One-ray rangefinders: the beam on the axis is the only one within half a gap. Were
+    # it read as "nothing seen", the robot would walk blind that way.
     beams = np.radians(np.arange(-180.0, 180.0, 1.0))
     ranges = np.full(beams.size, 0.4)
-    ranges[180] = math.nan  # invalid: skipped; no other beam within half an increment
-    ranges[240] = 0.01  # 60 deg, finite but below range_min: invalid too
-    readings = convert(beams[0], DEG, ranges, range_min=0.02)
-    assert readings[0] == 0.0 and readings[1] == 0.0
-    np.testing.assert_allclose(readings[2:], 0.65, atol=1e-12)
+    ranges[index] = value
+    with pytest.raises(InputError, match=f"rangefinder at {axis} deg"):
+        convert(beams[0], DEG, ranges, range_min=0.02)
+    nan_everywhere = np.full(beams.size, math.nan)
+    with pytest.raises(InputError, match="360 of the scan's 360 ranges"):
+        LaserToRangefinders(FOV_LAYOUT).readings(beams[0], DEG, nan_everywhere, 0.0, 10.0)
 
 
 def test_field_of_view_takes_the_nearest_beam_inside_it():

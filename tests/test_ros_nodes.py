@@ -39,9 +39,10 @@ def test_laser_node_publishes_readings_and_skips_malformed_scans(ros):
     bad = scan([0.5] * 360)
     bad.angle_increment = 0.0
     pub.publish(bad)
+    pub.publish(scan([math.nan] * 360))  # a failed scanner: blind, not "nothing seen"
     pub.publish(scan([0.5] * 360))
     assert ros.spin_until(lambda: len(out) >= 1)
-    assert len(out) == 1  # the malformed scan was skipped, the node kept going
+    assert len(out) == 1  # the malformed and the blind scan were skipped, the node kept going
     np.testing.assert_allclose(out[0].data, [0.55] * 6, atol=1e-6)
     assert out[0].layout.dim[0].label.split(",") == LAYOUT.input_names()[:6]
     assert node.context.ok()

@@ -2,7 +2,9 @@
 
 Subscribes ``scan`` (LaserScan, sensor-data QoS) and publishes ``evorbc/rangefinders``
 (std_msgs/Float64MultiArray, reliable): one reading in [0, 1] per configured rangefinder,
-labelled with the input names. Malformed scans are logged and skipped.
+labelled with the input names. Malformed scans, and scans whose beams towards a
+rangefinder are all invalid, are logged and skipped (the input goes stale and the robot
+stops).
 """
 
 from __future__ import annotations
@@ -54,6 +56,7 @@ class LaserSensorNode(Node):
         n = len(layout.rangefinders.angles)
         self.names = layout.input_names()[:n]
         self.pub = self.create_publisher(Float64MultiArray, out_topic, RELIABLE)
+        self.warned_span = None  # the last scan geometry checked for unseen rangefinders
         self.sub = self.create_subscription(LaserScan, self.scan_topic, self.on_scan, SENSOR_DATA)
 
     def on_scan(self, msg: LaserScan) -> None:
@@ -67,6 +70,15 @@ class LaserSensorNode(Node):
                 f"{self.scan_topic}: skipped a scan: {e}", throttle_duration_sec=2.0
             )
             return
+        span = (msg.angle_min, msg.angle_increment, len(msg.ranges))
+        if span != self.warned_span:
+            self.warned_span = span
+            unseen = self.converter.unseen(*span)
+            if unseen:
+                self.get_logger().warning(
+                    f"{self.scan_topic}: the scan never covers the rangefinders at {unseen} deg "
+                    "(body frame); they read 0, nothing seen"
+                )
         self.pub.publish(vector_message(readings, self.names))
 
 
