@@ -4,7 +4,8 @@ The executor runs the current primitive: it turns the primitive's genes into whe
 commands with the robot's own mapping (:mod:`evorbc_ros.robots.four_ws`). It watches when
 its inputs last arrived; if the primitive or any sensor input is older than
 ``stale_timeout`` it commands zero wheel speed (steering held where it is) until they come
-back. Times are seconds on the node's clock (simulated or wall).
+back. Times are seconds on the node's clock (simulated or wall); if that clock goes back,
+everything is forgotten and the robot stops until a new primitive arrives.
 """
 
 from __future__ import annotations
@@ -57,11 +58,31 @@ class InputWatch:
             )
         if not np.all(np.isfinite(g)) or np.any(np.abs(g) > 1.0 + 1e-9):
             raise InputError(f"primitive genes must be finite and in [-1, 1], got {g.tolist()}")
+        self.check_clock(now)  # before taking the genes: a reset would drop them
         self.genes = g
         self.on_input("primitive", now)
 
+    def check_clock(self, now: float) -> bool:
+        """Forget everything if the clock went back (a restarted ``/clock``, a looped bag).
+
+        Ages would be negative, so nothing would ever count as stale; after a reset the
+        robot stands until a new primitive and fresh inputs arrive. Returns True on reset.
+        """
+        latest = max((t for t in self.last_seen.values() if t is not None), default=None)
+        if latest is None or now >= latest - 1e-6:
+            return False
+        self.reset()
+        return True
+
+    def reset(self) -> None:
+        """Back to the start-up state: no primitive, no input seen."""
+        self.last_seen = dict.fromkeys(self.last_seen)
+        self.first_event = None
+        self.genes = None
+
     def on_input(self, name: str, now: float) -> None:
         """A sensor input arrived (only its time matters here)."""
+        self.check_clock(now)
         if self.first_event is None:
             self.first_event = now
         self.last_seen[name] = now
@@ -84,6 +105,8 @@ class InputWatch:
 
     def stop_reason(self, now: float) -> str:
         """Why the robot must stand still now ("" if it may run the primitive)."""
+        if self.check_clock(now):
+            return "the clock went back: waiting for a new primitive"
         if self.genes is None:
             return "no primitive yet"
         stale = self.stale(now)

@@ -38,7 +38,7 @@ from evorbc_ros.robots.hexapod import (
 class JointTargets:
     """One command for the hexapod: joint targets at evenly spaced times."""
 
-    positions: np.ndarray  # (points, 18) rad, JOINT_NAMES order
+    positions: np.ndarray  # (points, 18) rad, JOINT_NAMES order; no points: send nothing
     dt: float  # s between points; point k is the target from k * dt after the command on
     stopped: bool  # True when this is the safety stop (one point: hold)
     reason: str = ""
@@ -64,9 +64,17 @@ class HexapodExecutor(InputWatch):
         self.gait_start: float | None = None  # clock time (s) of the first primitive
         self.table: GaitTable | None = None
         # The last trajectory sent and the clock time (s) it was sent at; a stop holds the
-        # point that was being tracked then.
-        self.sent = self.geometry.neutral_pose()[None, :]  # (points, 18) rad
+        # point that was being tracked then. Nothing is sent before the first primitive:
+        # a made-up pose would jerk every joint of a real robot from wherever it stands,
+        # and a joint trajectory controller that has no command holds its position anyway.
+        self.sent = np.empty((0, 18))  # (points, 18) rad
         self.sent_at = 0.0
+
+    def reset(self) -> None:
+        """Back to the start-up state; the last targets sent are still held."""
+        super().reset()
+        self.gait_start = None
+        self.table = None
 
     def on_primitive(self, genes, now: float) -> None:
         """A new primitive; the gait clock starts with the first one."""
@@ -83,8 +91,9 @@ class HexapodExecutor(InputWatch):
         """Targets for the next ``horizon`` s from ``now``, or a hold if stopped."""
         reason = self.stop_reason(now)
         if reason:
-            k = min(max(round((now - self.sent_at) / self.dt), 0), len(self.sent) - 1)
-            self.sent, self.sent_at = self.sent[k : k + 1].copy(), now
+            if len(self.sent):  # hold the point being tracked; before any command, none
+                k = min(max(round((now - self.sent_at) / self.dt), 0), len(self.sent) - 1)
+                self.sent, self.sent_at = self.sent[k : k + 1].copy(), now
             return JointTargets(self.sent.copy(), self.dt, True, reason)
         times = gait_step_times(self.gait_step(now), self.points, self.dt)
         positions = self.table.joint_targets(times, np.zeros(self.points, dtype=np.int64))

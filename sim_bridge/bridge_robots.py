@@ -201,8 +201,10 @@ class HexapodBridge:
         if np.any(np.diff(times) <= 0):
             return "point times must increase", None
         # Zero-order hold: physics step k (at k * dt) tracks the last point due by then,
-        # over the whole span of the trajectory (times in s from receipt).
+        # over the span of the trajectory (times in s from receipt), but never past the
+        # episode: a point stamped hours ahead would otherwise allocate that many steps.
         steps = math.ceil(times[-1] / self.dt - 1e-6) + 1  # through the last point's step
+        steps = min(steps, math.ceil(self.world.episode_time / self.dt) + 1)
         due = np.searchsorted(times, np.arange(steps) * self.dt + 1e-6, side="right") - 1
         return "", np.asarray(rows)[np.clip(due, 0, None)]
 

@@ -21,12 +21,14 @@ from pathlib import Path
 
 from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorError
-from evorbc_ros.config import ConfigError
+from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.defaults import default_arbitrator
 from evorbc_ros.repertoire import RepertoireError
 from evorbc_ros.robots.hexapod import HEXAPOD, HexapodGeometry
+from evorbc_ros.sensors import SensorLayout
 from sim_bridge.bridge_node import episode_verdict
 from sim_bridge.bridge_robots import ROBOTS
+from sim_bridge.hexapod.maze_world import DEFAULT_SENSORS
 from sim_bridge.hexapod.physics import PhysicsSettings
 from sim_bridge.maze import load_named_maze, maze_names
 from sim_bridge.robots.hexapod import check_simulation, describe_simulation, simulation_mismatch
@@ -135,12 +137,21 @@ class Graph:
 
 
 def check_design(controller: Controller) -> None:
-    """Refuse a hexapod controller evolved for another design than the bridge simulates.
+    """Refuse a hexapod controller evolved for another design or laser than the bridge's.
 
     Raises:
         ConfigError: one line naming the file and the first setting that differs.
 
     """
+    # The bridge simulates the shipped laser; the sensor nodes read its scans with the
+    # arbitrator's layout, so another layout would feed the network inputs it never saw.
+    laser = SensorLayout.load(config_dir() / DEFAULT_SENSORS)
+    if controller.spec.sensors.fingerprint() != laser.fingerprint():
+        raise ConfigError(
+            f"{controller.arbitrator_path}: its sensor layout differs from the laser the "
+            f"bridge simulates (config/{DEFAULT_SENSORS}: 25 beams over +-90 deg, grouped "
+            "into 5)"
+        )
     bridge = describe_simulation(HexapodGeometry(), PhysicsSettings())
     if controller.repertoire is not None:
         check_simulation(controller.repertoire, bridge, controller.repertoire_path)

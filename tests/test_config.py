@@ -79,3 +79,15 @@ def test_every_shipped_arbitrator_run_file_loads_with_its_task_and_neat_files(pa
     assert task.samples_per_maze >= 1 and task.episode_time > 0
     # 6 sensor inputs and the 2 mapping outputs: the same for every family's NEAT file
     assert load_neat_config(run.neat_path(), 6, 2).pop_size > 0
+
+
+def test_a_task_whose_episode_is_not_whole_control_cycles_names_the_file_and_key(tmp_path):
+    from offline_evolution.maze_task.task import MazeTaskSettings
+
+    path = tmp_path / "task.yaml"
+    path.write_text("mazes: [hexapod]\nepisode_time: 30.05\nsensors: sensors/hexapod.yaml\n")
+    with pytest.raises(ConfigError) as info:
+        MazeTaskSettings.load(path)
+    message = str(info.value)
+    assert message.startswith(f"{path}: episode_time") and "0.1 s control period" in message
+    assert "\n" not in message

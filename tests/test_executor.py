@@ -43,3 +43,40 @@ def test_a_silent_input_stops_the_robot_with_the_steering_held():
 def test_bad_primitives_are_refused(genes):
     with pytest.raises(InputError):
         executor().on_primitive(genes, 0.0)
+
+
+def test_a_clock_that_goes_back_forgets_everything_and_stops_the_robot():
+    # A restarted /clock or a looped bag: ages would be negative and never stale.
+    ex = executor()
+    for name in ("rf", "goal"):
+        ex.on_input(name, 10.0)
+    ex.on_primitive([1.0, 0.5, 0.5, -0.5, -0.5], 10.0)
+    assert not ex.command(10.0).stopped
+    back = ex.command(1.0)
+    assert back.stopped and "clock went back" in back.reason and back.speed == 0.0
+    ex.on_input("rf", 1.1)
+    ex.on_input("goal", 1.1)
+    assert ex.command(1.1).reason == "no primitive yet"  # the old primitive is forgotten
+    ex.on_primitive([1.0, 0.5, 0.5, -0.5, -0.5], 1.2)
+    assert not ex.command(1.2).stopped
+    ex.on_input("rf", 0.5)  # an input stamped before the others: a reset as well
+    assert ex.command(0.5).reason == "no primitive yet"
+
+
+def test_the_hexapod_executor_sends_nothing_before_its_first_primitive():
+    from evorbc_ros.hexapod_executor import HexapodExecutor
+
+    ex = HexapodExecutor(["rf"], stale_timeout=0.3)
+    ex.on_input("rf", 0.0)
+    first = ex.command(0.0)
+    # No made-up pose: a real robot would jerk every joint to it from wherever it stands.
+    assert first.stopped and first.positions.shape == (0, 18)
+    ex.on_primitive(np.linspace(-1, 1, 37), 0.1)
+    walking = ex.command(0.1)
+    assert not walking.stopped and len(walking.positions) == 15
+    # The clock goes back: the gait restarts with the next primitive, and meanwhile the
+    # legs hold the point they were tracking.
+    held = ex.command(0.05)
+    assert held.stopped and "clock went back" in held.reason
+    np.testing.assert_array_equal(held.positions, walking.positions[:1])
+    assert ex.gait_start is None

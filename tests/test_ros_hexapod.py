@@ -192,6 +192,13 @@ def test_bridge_skips_malformed_trajectories_and_holds_the_last_targets():
         bridge._store(JointTrajectory(joint_names=["x"]), stored.append)
         assert stored == ["trajectory"] and len(node.warnings) == 2
         assert "finite" in node.warnings[0] and "18 joints" in node.warnings[1]
+        far = JointTrajectory(joint_names=list(JOINT_NAMES))
+        far.points = [JointTrajectoryPoint(positions=q.tolist(), time_from_start=Duration()),
+                      JointTrajectoryPoint(positions=q.tolist(),
+                                           time_from_start=Duration(sec=2**31 - 1))]  # fmt: skip
+        bridge._store(far, [].append)  # 68 years ahead: resampled through the episode only
+        assert len(bridge.trajectory) == 30 * 50 + 1
+        bridge._store(good, stored.append)
         bridge.advance()
         np.testing.assert_allclose(bridge.world.targets, 2 * q)
         # A trajectory of three periods: without a new one the legs walk on through it,
@@ -255,3 +262,20 @@ def test_evorbc_sim_refuses_an_arbitrator_for_another_robot(capsys):
     assert err == [
         f"evorbc-sim: error: {default_arbitrator()}: is for robot 4ws-5, not --robot hexapod"
     ]
+
+
+def test_evorbc_sim_refuses_an_arbitrator_evolved_with_another_laser(tmp_path, controller, capsys):
+    import dataclasses
+
+    from evorbc_ros.sensors import SensorLayout
+    from sim_bridge.bringup import main
+
+    arb_path, rep_path, _, _ = controller
+    arb = ArbitratorFile.load(arb_path)
+    layout = arb.sensors.to_dict()
+    layout["rangefinders"] = {**layout["rangefinders"], "range": 4.0}  # a longer-range laser
+    path = tmp_path / "other-laser.json"
+    dataclasses.replace(arb, sensors=SensorLayout.from_dict(layout)).save(path)
+    assert main(["--arbitrator", str(path), "--repertoire", str(rep_path)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"evorbc-sim: error: {path}: its sensor layout")

@@ -155,7 +155,8 @@ class PrimitiveExecutorNode(Node):
             self.get_logger().info("inputs are back: running the primitive again")
         self.stopped_reason = command.reason if command.stopped else ""
         if isinstance(command, JointTargets):
-            self.trajectory_pub.publish(trajectory_message(command))
+            if len(command.positions):  # none before the first primitive: nothing to hold
+                self.trajectory_pub.publish(trajectory_message(command))
         else:
             self.publish_wheels(command)
         self.last_publish = now

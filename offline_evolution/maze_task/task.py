@@ -18,7 +18,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from evorbc_ros.config import build_settings, config_dir, load_yaml_mapping, setting
+from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
 from evorbc_ros.mapping import MappingFunction, PrimitiveLookup
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.sensors import SensorLayout
@@ -35,6 +35,10 @@ from sim_bridge.sensors import compile_layout
 _CHUNK = 4
 
 
+#: s between the arbitrator's decisions, for the 4WS robots and the hexapod alike.
+CONTROL_PERIOD = 0.1
+
+
 @dataclass(frozen=True)
 class MazeTaskSettings:
     """What defines the task (``config/tasks/*.yaml``)."""
@@ -46,8 +50,19 @@ class MazeTaskSettings:
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> MazeTaskSettings:
-        """Settings from a task file (``config/tasks/*.yaml``)."""
-        return build_settings(cls, load_yaml_mapping(path), str(path))
+        """Settings from a task file (``config/tasks/*.yaml``).
+
+        Raises:
+            ConfigError: naming the file and the key, for any bad setting; episode_time
+                must be a whole number of the 0.1 s control cycles that every robot
+                family here uses (paper Sec. III-C).
+        """
+        settings = build_settings(cls, load_yaml_mapping(path), str(path))
+        try:
+            control_steps(settings.episode_time, CONTROL_PERIOD)
+        except ValueError as e:
+            raise ConfigError(f"{path}: episode_time {e}") from None
+        return settings
 
     def as_dict(self) -> dict:
         """Plain-data form (recorded in arbitrator files)."""
