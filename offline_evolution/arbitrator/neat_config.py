@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import configparser
 import io
+import math
 import os
 import tempfile
 from pathlib import Path
@@ -15,6 +16,13 @@ from evorbc_ros.network import ACTIVATIONS, AGGREGATIONS
 from offline_evolution.arbitrator.neat_classes import EvoRBCGenome, TargetSpeciesSet
 
 GENOME_SECTION = EvoRBCGenome.__name__
+#: neat-python's ways of connecting a new genome (first word; "partial" takes a fraction).
+INITIAL_CONNECTIONS = (
+    "unconnected", "fs_neat_nohidden", "fs_neat", "fs_neat_hidden", "full_nodirect", "full",
+    "full_direct", "partial_nodirect", "partial", "partial_direct",
+)  # fmt: skip
+#: species_fitness_func values neat-python's stagnation knows.
+SPECIES_FITNESS = ("max", "min", "mean", "median")
 
 
 def default_neat_file(robot: str) -> Path:
@@ -45,6 +53,7 @@ def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int)
             f"{source}: missing section [{GENOME_SECTION}] (evorbc's genome "
             "class; see config/neat/4ws.ini)"
         )
+    _check_limits(parser[GENOME_SECTION], source)
     parser[GENOME_SECTION]["num_inputs"] = str(num_inputs)
     parser[GENOME_SECTION]["num_outputs"] = str(num_outputs)
     buf = io.StringIO()
@@ -57,11 +66,16 @@ def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int)
         config = neat.Config(
             EvoRBCGenome, neat.DefaultReproduction, TargetSpeciesSet, neat.DefaultStagnation, tmp
         )
+    except AssertionError:  # neat-python asserts on an unknown initial_connection
+        raise ConfigError(
+            f"{source}: initial_connection must be one of {', '.join(INITIAL_CONNECTIONS)}"
+        ) from None
     except Exception as e:  # neat-python raises bare RuntimeError/NameError/... on bad input
         first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
         raise ConfigError(f"{source}: {first}") from None
     finally:
         os.unlink(tmp)
+    _check_values(config, parser, source)
     g = config.genome_config
     if not g.feed_forward:
         raise ConfigError(f"{source}: feed_forward must be True (arbitrators are feed-forward)")
@@ -75,3 +89,79 @@ def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int)
                     f"{source}: {what} {name!r} is not supported; use one of {', '.join(known)}"
                 )
     return config
+
+
+def _check_limits(genome: configparser.SectionProxy, source: str) -> None:
+    """Refuse a min above its max (neat-python's own message names no key)."""
+    for attr in ("bias", "response", "weight"):
+        try:
+            low = float(genome.get(f"{attr}_min_value", "-inf"))
+            high = float(genome.get(f"{attr}_max_value", "inf"))
+        except ValueError:
+            continue  # not numbers: neat-python names the problem
+        if low > high:
+            raise ConfigError(
+                f"{source}: [{GENOME_SECTION}] {attr}_min_value ({low}) is above "
+                f"{attr}_max_value ({high})"
+            )
+
+
+def _check_values(config: neat.Config, parser: configparser.ConfigParser, source: str) -> None:
+    """Refuse settings neat-python accepts but that fail later, or that are typos.
+
+    neat-python checks types but not ranges, ignores unknown keys outside [NEAT], and
+    reports some problems only generations into a run; each check here names the key.
+
+    Raises:
+        ConfigError: ``FILE: [section] key ...`` in one line.
+    """
+    sections = {
+        GENOME_SECTION: config.genome_config,
+        "TargetSpeciesSet": config.species_set_config,
+        "DefaultStagnation": config.stagnation_config,
+        "DefaultReproduction": config.reproduction_config,
+    }
+    for name, cfg in sections.items():
+        known = {p.name for p in cfg._params} | (
+            {"crossover_probability"} if name == GENOME_SECTION else set()
+        )
+        for key, text in parser[name].items():
+            where = f"{source}: [{name}] {key}"
+            if key not in known:
+                raise ConfigError(f"{where} is not a setting of this section")
+            try:
+                value = float(text)
+            except ValueError:
+                continue  # words (sigmoid, gaussian, ...): neat-python checked them
+            if not math.isfinite(value):
+                raise ConfigError(f"{where} must be a finite number, got {text}")
+            if key.endswith(("_prob", "_rate", "_probability", "_add")) and not 0 <= value <= 1:
+                raise ConfigError(f"{where} is a probability and must be in [0, 1], got {text}")
+    pop, rep, spc = config.pop_size, config.reproduction_config, config.species_set_config
+    checks = (
+        (pop >= 2, "[NEAT] pop_size must be at least 2", pop),
+        (0 <= rep.elitism < pop, "[DefaultReproduction] elitism must be in [0, pop_size)",
+         rep.elitism),
+        (rep.min_species_size >= 1, "[DefaultReproduction] min_species_size must be >= 1",
+         rep.min_species_size),
+        (0 < rep.survival_threshold <= 1,
+         "[DefaultReproduction] survival_threshold must be in (0, 1]", rep.survival_threshold),
+        (spc.compatibility_threshold > 0,
+         "[TargetSpeciesSet] compatibility_threshold must be > 0", spc.compatibility_threshold),
+        (spc.target_species_count >= 1, "[TargetSpeciesSet] target_species_count must be >= 1",
+         spc.target_species_count),
+        (spc.threshold_min > 0, "[TargetSpeciesSet] threshold_min must be > 0",
+         spc.threshold_min),
+        (spc.threshold_step >= 0, "[TargetSpeciesSet] threshold_step must be >= 0",
+         spc.threshold_step),
+        (config.stagnation_config.species_fitness_func in SPECIES_FITNESS,
+         f"[DefaultStagnation] species_fitness_func must be one of {', '.join(SPECIES_FITNESS)}",
+         config.stagnation_config.species_fitness_func),
+        # Every species keeps at least min_species_size genomes: the target number of
+        # species must fit in the population, or reproduction fails mid-run.
+        (spc.target_species_count * max(rep.min_species_size, rep.elitism) <= pop,
+         "[NEAT] pop_size must hold target_species_count x min_species_size genomes", pop),
+    )  # fmt: skip
+    for ok, what, value in checks:
+        if not ok:
+            raise ConfigError(f"{source}: {what}, got {value}")
