@@ -91,3 +91,34 @@ def test_a_task_whose_episode_is_not_whole_control_cycles_names_the_file_and_key
     message = str(info.value)
     assert message.startswith(f"{path}: episode_time") and "0.1 s control period" in message
     assert "\n" not in message
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("mazes: []\nsensors: sensors/4ws.yaml\n", "mazes must name at least one maze"),
+        ("mazes: [nowhere]\nsensors: sensors/4ws.yaml\n", "mazes: unknown maze 'nowhere'"),
+        ("mazes: [obstacle]\nsensors: sensors/nope.yaml\n", "sensors: no such file"),
+    ],
+)
+def test_a_task_file_names_itself_when_what_it_refers_to_is_wrong(tmp_path, text, needle):
+    from offline_evolution.maze_task.task import MazeTaskSettings
+
+    path = tmp_path / "task.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as info:
+        MazeTaskSettings.load(path)
+    assert str(info.value).startswith(f"{path}: {needle}")
+
+
+@pytest.mark.parametrize("key", ["neat", "task"])
+def test_an_arbitrator_run_file_names_itself_when_a_referred_file_is_missing(tmp_path, key):
+    from offline_evolution.arbitrator.settings import load_run_settings
+
+    path = tmp_path / "run.yaml"
+    values = {"generations": 1, "neat": "neat/4ws.ini", "task": "tasks/maze-4ws.yaml"}
+    values[key] = "nope.yaml"
+    path.write_text("".join(f"{k}: {v}\n" for k, v in values.items()))
+    with pytest.raises(ConfigError) as info:
+        load_run_settings(path)
+    assert str(info.value).startswith(f"{path}: {key}: no such file")

@@ -6,7 +6,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from evorbc_ros.config import build_settings, config_dir, load_yaml_mapping, setting
+from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
 from evorbc_ros.mapping import MAPPINGS
 
 
@@ -43,4 +43,11 @@ def load_run_settings(
     if path is None:
         family = "hexapod" if robot == "hexapod" else "4ws"
         path = config_dir() / "arbitrator" / f"{family}.yaml"
-    return build_settings(ArbitratorRunSettings, load_yaml_mapping(path), str(path))
+    settings = build_settings(ArbitratorRunSettings, load_yaml_mapping(path), str(path))
+    # The files it refers to, checked here so that an error names this file and key.
+    for key, target in (("neat", settings.neat_path()), ("task", settings.task_path())):
+        if not target.is_file():
+            raise ConfigError(
+                f"{path}: {key}: no such file {target} (relative paths are from config/)"
+            )
+    return settings

@@ -62,6 +62,19 @@ class MazeTaskSettings:
             control_steps(settings.episode_time, CONTROL_PERIOD)
         except ValueError as e:
             raise ConfigError(f"{path}: episode_time {e}") from None
+        if not settings.mazes:
+            raise ConfigError(f"{path}: mazes must name at least one maze")
+        # The files the task refers to, checked here so that an error names this file.
+        for name in settings.mazes:
+            try:
+                load_named_maze(name)
+            except ConfigError as e:
+                raise ConfigError(f"{path}: mazes: {e}") from None
+        if not (config_dir() / settings.sensors).is_file():
+            raise ConfigError(
+                f"{path}: sensors: no such file {config_dir() / settings.sensors} "
+                "(the path is relative to config/)"
+            )
         return settings
 
     def as_dict(self) -> dict:
