@@ -16,10 +16,10 @@ import itertools
 import math
 
 import numpy as np
-import pybullet as p
 
 from sim_bridge.geometry import box_corners
 from sim_bridge.maze import Maze
+from sim_bridge.quiet_pybullet import p
 
 #: Collision groups: rays and the footprint test only against walls.
 WALL_GROUP, ROBOT_GROUP = 1, 2

@@ -23,10 +23,10 @@ import tempfile
 from dataclasses import dataclass
 
 import numpy as np
-import pybullet as p
 
 from evorbc_ros.robots.hexapod import SERVO_RATE, HexapodGeometry, gait_step_times
 from sim_bridge.hexapod.urdf import hexapod_urdf
+from sim_bridge.quiet_pybullet import p
 
 #: Collision groups: laser rays see only walls; the robot touches ground and walls.
 WALL_GROUP, ROBOT_GROUP, GROUND_GROUP = 1, 2, 4
