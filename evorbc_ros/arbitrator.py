@@ -17,14 +17,18 @@ An arbitrator file is JSON, versioned, never pickled::
 
 An EvoRBC arbitrator only makes sense with the repertoire it was evolved with; loading it
 with another repertoire (different fingerprint) or another sensor layout is an error unless
-the caller explicitly allows the mismatch, which then comes back as a warning.
+the caller explicitly allows the mismatch, which then comes back as a warning. A repertoire
+for another robot is always an error: its primitives cannot drive this robot at all.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
+import reprlib
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -33,7 +37,7 @@ from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.json_files import load_json_file
 from evorbc_ros.mapping import MAPPINGS, MappingFunction, PrimitiveLookup
 from evorbc_ros.network import NetworkError, NetworkSpec
-from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire, robot_problem
 from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.sensors import SensorLayout
 
@@ -117,6 +121,9 @@ class ArbitratorFile:
         for key in ("robot", "network", "sensors"):
             if key not in data:
                 raise ArbitratorError(f"{source}: missing key {key}")
+        problem = robot_problem(data["robot"])
+        if problem:
+            raise ArbitratorError(f"{source}: {problem}")
         try:
             network = NetworkSpec.from_dict(data["network"])
         except NetworkError as e:
@@ -132,19 +139,14 @@ class ArbitratorFile:
                 f"{source}: the network has {len(network.input_keys)} inputs "
                 f"but the sensor layout gives {sensors.n_inputs}"
             )
-        fp = data.get("sensors_fingerprint")
-        if fp is not None and fp != sensors.fingerprint():
-            raise ArbitratorError(
-                f"{source}: sensors_fingerprint does not match the sensors "
-                "section (the file was edited)"
-            )
+        _check_sensor_records(data, sensors, source)
         out = cls(
             kind=kind,
-            robot=str(data["robot"]),
+            robot=data["robot"],
             network=network,
             sensors=sensors,
-            control_period=float(data.get("control_period", 0.1)),
-            evolution=data.get("evolution", {}) or {},
+            control_period=_control_period(data, source),
+            evolution=_evolution(data, source),
         )
         if kind == "evorbc":
             if data.get("mapping") not in MAPPINGS:
@@ -152,6 +154,13 @@ class ArbitratorFile:
             rep = data.get("repertoire")
             if not isinstance(rep, dict) or not isinstance(rep.get("fingerprint"), str):
                 raise ArbitratorError(f"{source}: repertoire.fingerprint is missing")
+            named = rep.get("file")
+            # Readers look for the file next to the arbitrator; a path could lead anywhere.
+            if named is not None and not _plain_file_name(named):
+                raise ArbitratorError(
+                    f"{source}: repertoire.file must be a plain file name (no folder), "
+                    f"got {reprlib.repr(named)}"
+                )
             if len(network.output_keys) != 2:
                 raise ArbitratorError(
                     f"{source}: an EvoRBC network needs 2 outputs, it has "
@@ -174,51 +183,134 @@ class ArbitratorFile:
                     f"{source}: {len(network.output_keys)} outputs but "
                     f"{len(out.parameters)} parameters"
                 )
+            problem = robot_problem(out.robot, len(out.parameters))
+            if problem:
+                raise ArbitratorError(f"{source}: {problem}")
         return out
 
     def check_repertoire(
-        self, repertoire: Repertoire, source: str, allow_mismatch: bool = False
+        self, repertoire: Repertoire, source: str, allow_mismatch: bool = False, waiver: str = ""
     ) -> list[str]:
         """Check that ``repertoire`` is the one this arbitrator was evolved with.
 
+        Args:
+            waiver: how the caller's user allows a mismatch (``"--allow-mismatch"``), named
+                in the error; empty when the caller offers no way.
+
         Returns:
-            Warnings (only when ``allow_mismatch`` let a mismatch through).
+            Warnings (only when ``allow_mismatch`` let another fingerprint through).
 
         Raises:
-            ArbitratorError: a mismatch, unless ``allow_mismatch``.
+            ArbitratorError: a repertoire for another robot or gene count (always), or
+                another fingerprint unless ``allow_mismatch``.
         """
         if self.kind != "evorbc":
             return []
-        problems = []
+        head = f"repertoire {source} does not match the arbitrator"
         if repertoire.robot != self.robot:
-            problems.append(f"it is for robot {repertoire.robot}, the arbitrator for {self.robot}")
+            raise ArbitratorError(
+                f"{head}: it is for robot {repertoire.robot}, the arbitrator for {self.robot}"
+            )
+        if repertoire.n_parameters != ROBOT_PARAMETERS[self.robot]:  # made in memory
+            raise ArbitratorError(
+                f"{head}: its primitives have {repertoire.n_parameters} parameters, "
+                f"robot {self.robot} has {ROBOT_PARAMETERS[self.robot]}"
+            )
         expected = (self.repertoire or {}).get("fingerprint")
         got = repertoire.fingerprint()
-        if expected != got:
-            problems.append(
-                f"its fingerprint is {got[:12]}, the arbitrator was evolved with "
-                f"{str(expected)[:12]}"
-            )
-        if not problems:
+        if expected == got:
             return []
-        message = f"repertoire {source} does not match the arbitrator: {'; '.join(problems)}"
-        if not allow_mismatch:
-            raise ArbitratorError(message + " (allow the mismatch explicitly to use it anyway)")
-        return [message]
+        message = (
+            f"{head}: its fingerprint is {got[:12]}, the arbitrator was evolved with "
+            f"{str(expected)[:12]}"
+        )
+        return _mismatch(message, allow_mismatch, waiver)
 
     def check_sensors(
-        self, layout: SensorLayout, source: str, allow_mismatch: bool = False
+        self, layout: SensorLayout, source: str, allow_mismatch: bool = False, waiver: str = ""
     ) -> list[str]:
-        """Check that the onboard sensor layout is the one the arbitrator expects."""
+        """Check that the onboard sensor layout is the one the arbitrator expects.
+
+        Returns and raises as :meth:`check_repertoire` does for another fingerprint.
+        """
         if layout.fingerprint() == self.sensors.fingerprint():
             return []
         message = (
             f"sensor layout {source} differs from the arbitrator's "
             f"({layout.input_names()} vs {self.sensors.input_names()})"
         )
-        if not allow_mismatch:
-            raise ArbitratorError(message + " (allow the mismatch explicitly to use it anyway)")
+        return _mismatch(message, allow_mismatch, waiver)
+
+
+def _mismatch(message: str, allow: bool, waiver: str) -> list[str]:
+    """The warning for a mismatch the caller allowed; else raise, naming ``waiver`` if any."""
+    if allow:
         return [message]
+    hint = f" (pass {waiver} to use it anyway)" if waiver else ""
+    raise ArbitratorError(message + hint)
+
+
+def _check_sensor_records(data: dict, sensors: SensorLayout, source: str) -> None:
+    """The fingerprint and input names recorded next to the sensors section must match it.
+
+    Both are required: the fingerprint is what reveals a hand-edited sensors section.
+    """
+    fp = data.get("sensors_fingerprint")
+    if fp is None:
+        raise ArbitratorError(f"{source}: missing key sensors_fingerprint")
+    if fp != sensors.fingerprint():
+        raise ArbitratorError(
+            f"{source}: sensors_fingerprint does not match the sensors "
+            "section (the file was edited)"
+        )
+    names = data.get("inputs")
+    expected = sensors.input_names()
+    if not isinstance(names, list):
+        raise ArbitratorError(f"{source}: inputs must list the {len(expected)} input names")
+    if names != expected:
+        k = next((k for k, (a, b) in enumerate(zip(names, expected, strict=False)) if a != b), None)
+        detail = (
+            f"inputs[{k}] is {reprlib.repr(names[k])}, the sensor layout's is {expected[k]!r}"
+            if k is not None
+            else f"{len(names)} input names, the sensor layout gives {len(expected)}"
+        )
+        raise ArbitratorError(f"{source}: inputs do not match the sensors section ({detail})")
+
+
+def _plain_file_name(name: Any) -> bool:
+    """A file name without any folder part (``r.json``, not ``../r.json`` or ``..``)."""
+    return isinstance(name, str) and name not in ("", ".", "..") and Path(name).name == name
+
+
+def _control_period(data: dict, source: str) -> float:
+    """``control_period`` (s): a finite number > 0; 0.1 s when the file has none."""
+    value = data.get("control_period", 0.1)
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float))
+        or not (math.isfinite(value) and value > 0)
+    ):
+        raise ArbitratorError(
+            f"{source}: control_period must be a number of seconds > 0, got {reprlib.repr(value)}"
+        )
+    return float(value)
+
+
+def _evolution(data: dict, source: str) -> dict:
+    """The ``evolution`` record: a mapping; replay rebuilds its ``task`` settings."""
+    evolution = data.get("evolution", {})
+    if evolution is None:
+        return {}
+    if not isinstance(evolution, dict):
+        raise ArbitratorError(
+            f"{source}: evolution must be a mapping, got {reprlib.repr(evolution)}"
+        )
+    for key in ("task", "simulation"):
+        if key in evolution and not isinstance(evolution[key], (dict, type(None))):
+            raise ArbitratorError(
+                f"{source}: evolution.{key} must be a mapping, got {reprlib.repr(evolution[key])}"
+            )
+    return evolution
 
 
 class Arbitrator:

@@ -16,8 +16,8 @@ def load_json_file(path: str | os.PathLike, what: str, error: type[Exception]) -
         error: the exception class to raise.
 
     Raises:
-        ``error``: missing, unreadable, not UTF-8, or truncated/corrupt JSON, in one line
-        that starts with the path.
+        ``error``: missing, unreadable, not UTF-8, or truncated/corrupt (also absurdly
+        nested) JSON, in one line that starts with the path.
     """
     source = str(path)
     try:
@@ -30,6 +30,9 @@ def load_json_file(path: str | os.PathLike, what: str, error: type[Exception]) -
         raise error(f"{source}: cannot read ({e.strerror})") from None
     try:
         return json.loads(text)
+    except RecursionError:
+        # The decoder recurses once per nesting level; no file of ours nests this deeply.
+        raise error(f"{source}: corrupt {what} file (invalid JSON: nested too deeply)") from None
     except json.JSONDecodeError as e:
         kind = "truncated" if e.pos >= len(text.rstrip()) else "corrupt"
         raise error(

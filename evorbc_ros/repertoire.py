@@ -28,6 +28,7 @@ import io
 import json
 import math
 import os
+import reprlib
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -35,10 +36,26 @@ import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.json_files import load_json_file
+from evorbc_ros.robots.four_ws import ROBOT_TYPES
+from evorbc_ros.robots.hexapod import HEXAPOD, N_PARAMETERS
 from evorbc_ros.robots.primitive import GENE_HIGH, GENE_LOW, ParameterSpec
 
 FORMAT = "evorbc-repertoire"
 VERSION = 1
+
+#: Locomotion parameters (genes) of a primitive of each robot a repertoire can be for.
+ROBOT_PARAMETERS = {**{n: t.n_parameters for n, t in ROBOT_TYPES.items()}, HEXAPOD: N_PARAMETERS}
+
+#: Names of the quality metrics. They are defined in offline_evolution.quality, which this
+#: onboard package must not import; a test keeps the two lists equal.
+METRICS = (
+    "circular",
+    "radial",
+    "distance",
+    "distance+circular",
+    "distance+radial",
+    "circular+tilt",
+)
 
 
 class RepertoireError(ValueError):
@@ -244,7 +261,11 @@ class Repertoire:
 
         """
         data = load_json_file(path, "repertoire", RepertoireError)
-        return cls.from_dict(data, str(path))
+        repertoire = cls.from_dict(data, str(path))
+        # Valid as data, but nothing can run on it: every arbitrator needs a primitive.
+        if len(repertoire) == 0:
+            raise RepertoireError(f"{path}: the repertoire has no primitives")
+        return repertoire
 
 
 def _require(data: dict, key: str, kind, source: str, prefix: str = ""):
@@ -260,11 +281,57 @@ def _require(data: dict, key: str, kind, source: str, prefix: str = ""):
     return value
 
 
+def robot_problem(robot: Any, n_parameters: int | None = None) -> str | None:
+    """Why ``robot`` (with ``n_parameters`` genes, if given) is no robot we know, or None."""
+    if not isinstance(robot, str) or robot not in ROBOT_PARAMETERS:
+        return f"robot {robot!r} is not known; known robots: {', '.join(ROBOT_PARAMETERS)}"
+    expected = ROBOT_PARAMETERS[robot]
+    if n_parameters is not None and n_parameters != expected:
+        return f"robot {robot} has {expected} parameters, the file has {n_parameters}"
+    return None
+
+
+def _archive_problem(archive: dict) -> str | None:
+    """The first problem with the archive layout (offline_evolution.repertoire.archive)."""
+    if not archive:
+        return None  # a repertoire made in memory without one: nothing reads it
+    kind = archive.get("kind")
+    if kind not in ("grid", "cvt"):
+        return f"archive.kind must be grid or cvt, got {reprlib.repr(kind)}"
+    for key in ("low", "high"):
+        value = archive.get(key)
+        if not (isinstance(value, list) and len(value) == 2 and all(map(_finite, value))):
+            return f"archive.{key} must be 2 finite numbers (m), got {reprlib.repr(value)}"
+    if not all(lo < hi for lo, hi in zip(archive["low"], archive["high"], strict=True)):
+        return "archive.low must be below archive.high"
+    if kind == "grid":
+        dims = archive.get("dims")
+        if not (isinstance(dims, list) and len(dims) == 2 and all(map(_positive_int, dims))):
+            return f"archive.dims must be 2 positive integers, got {reprlib.repr(dims)}"
+    elif not _positive_int(archive.get("cells")):
+        return f"archive.cells must be a positive integer, got {reprlib.repr(archive.get('cells'))}"
+    return None
+
+
+def _positive_int(value: Any) -> bool:
+    """A JSON integer (not a boolean) > 0."""
+    return isinstance(value, int) and not isinstance(value, bool) and value > 0
+
+
+def _finite(value: Any) -> bool:
+    """A JSON number (not a boolean) that is finite."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
 def _problem(r: Repertoire) -> str | None:
-    """The first problem with shapes, finiteness or ranges, or None if there is none."""
+    """The first problem with robot, metric, shapes, finiteness or ranges, or None."""
     n = r.quality.shape[0] if r.quality.ndim == 1 else -1
     d = len(r.parameters)
     checks = [
+        (
+            r.metric in METRICS,
+            f"metric must be one of {', '.join(METRICS)}, got {reprlib.repr(r.metric)}",
+        ),
         (
             r.quality.ndim == 1,
             f"primitives.quality must be a list of numbers, got shape {r.quality.shape}",
@@ -282,7 +349,6 @@ def _problem(r: Repertoire) -> str | None:
             r.heading.shape == (n,),
             f"primitives.heading has shape {r.heading.shape}, expected ({n},)",
         ),
-        (d > 0, "parameters must not be empty"),
         (
             math.isfinite(r.eval_time) and r.eval_time > 0,
             f"eval_time must be > 0 s, got {r.eval_time}",
@@ -292,6 +358,10 @@ def _problem(r: Repertoire) -> str | None:
     for ok, message in checks:
         if not ok:
             return message
+    # After the shapes, so that genes and parameters that disagree are named as such.
+    problem = robot_problem(r.robot, d)
+    if problem:
+        return problem
     for name in ("genes", "behaviour", "heading", "quality"):
         if not np.all(np.isfinite(getattr(r, name))):
             return f"primitives.{name} contains NaN or infinity"
@@ -300,4 +370,7 @@ def _problem(r: Repertoire) -> str | None:
     for k, p in enumerate(r.parameters):
         if not (math.isfinite(p.low) and math.isfinite(p.high) and p.low < p.high):
             return f"parameters[{k}] ({p.name}) needs low < high"
-    return None
+    simulation = r.algorithm.get("simulation")  # compared key by key with the robot's
+    if simulation is not None and not isinstance(simulation, dict):
+        return f"algorithm.simulation must be a mapping, got {reprlib.repr(simulation)}"
+    return _archive_problem(r.archive)

@@ -14,11 +14,11 @@ never a traceback (set ``EVORBC_DEBUG=1`` to see one for an unexpected failure).
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from collections.abc import Sequence
 
 from evorbc_ros.arbitrator import ArbitratorError
+from evorbc_ros.cli_support import report_unexpected
 from evorbc_ros.config import ConfigError
 from evorbc_ros.repertoire import RepertoireError
 from offline_evolution.checkpoint import CheckpointError
@@ -55,19 +55,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("evorbc-evolve: aborted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except OSError as e:
-        where = f"{e.filename}: " if e.filename else ""
-        print(f"evorbc-evolve: error: {where}{e.strerror or e}", file=sys.stderr)
-        return EXIT_ERROR
     except Exception as e:
-        if os.environ.get("EVORBC_DEBUG"):
-            raise
-        print(
-            f"evorbc-evolve: internal error: {type(e).__name__}: {e} "
-            "(set EVORBC_DEBUG=1 for a traceback)",
-            file=sys.stderr,
-        )
-        return EXIT_ERROR
+        return report_unexpected("evorbc-evolve", e)
 
 
 if __name__ == "__main__":

@@ -21,17 +21,22 @@ from pathlib import Path
 
 from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorError
+from evorbc_ros.cli_support import check_output_file, report_unexpected
 from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.defaults import default_arbitrator
+from evorbc_ros.nodes.common import StartupError
 from evorbc_ros.repertoire import RepertoireError
 from evorbc_ros.robots.hexapod import HEXAPOD, HexapodGeometry
 from evorbc_ros.sensors import SensorLayout
-from sim_bridge.bridge_node import episode_verdict
-from sim_bridge.bridge_robots import ROBOTS
+from sim_bridge.bridge_node import SimBridgeNode, episode_verdict
+from sim_bridge.bridge_robots import ROBOTS, bridge_robot_class
 from sim_bridge.hexapod.maze_world import DEFAULT_SENSORS
 from sim_bridge.hexapod.physics import PhysicsSettings
-from sim_bridge.maze import load_named_maze, maze_names
+from sim_bridge.maze import Maze, load_named_maze, maze_names
 from sim_bridge.robots.hexapod import check_simulation, describe_simulation, simulation_mismatch
+
+#: Highest ROS_DOMAIN_ID: DDS derives UDP ports from it, and above 232 they pass 65535.
+MAX_DOMAIN_ID = 232
 
 NODES = {
     "laser_sensor": "evorbc_ros.nodes.laser_sensor",
@@ -39,6 +44,22 @@ NODES = {
     "arbitrator": "evorbc_ros.nodes.arbitrator",
     "primitive_executor": "evorbc_ros.nodes.primitive_executor",
 }
+
+
+def _int_range(low: int, high: int | None = None):
+    """Argparse type: an integer in ``[low, high]`` (no upper bound if ``high`` is None)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < low or (high is not None and value > high):
+            bounds = f"from {low} to {high}" if high is not None else f">= {low}"
+            raise argparse.ArgumentTypeError(f"expected an integer {bounds}, got {text!r}")
+        return value
+
+    return parse
 
 
 def parse_args(argv=None) -> argparse.Namespace:
@@ -76,15 +97,16 @@ def parse_args(argv=None) -> argparse.Namespace:
         help="lockstep: deterministic and fast (default); realtime: 10 Hz wall clock",
     )
     p.add_argument("--start", default="nominal", help="nominal, random or 'x,y,heading_deg'")
-    p.add_argument("--seed", type=int, default=0, help="seed of a random start")
+    p.add_argument("--seed", type=_int_range(0), default=0, help="seed of a random start")
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--plot", default="", help="trajectory picture (default: <maze>-run.png)")
     p.add_argument("--result", default="", help="also keep the result as JSON here")
     p.add_argument(
         "--domain-id",
-        type=int,
+        type=_int_range(0, MAX_DOMAIN_ID),
         default=None,
-        help="ROS_DOMAIN_ID for the graph (default: the environment's, else 0)",
+        help=f"ROS_DOMAIN_ID for the graph, 0 to {MAX_DOMAIN_ID} (default: the environment's, "
+        "else 0)",
     )
     p.add_argument("--quiet", action="store_true", help="only the result line")
     return p.parse_args(argv)
@@ -155,7 +177,6 @@ def check_design(controller: Controller) -> None:
     bridge = describe_simulation(HexapodGeometry(), PhysicsSettings())
     if controller.repertoire is not None:
         check_simulation(controller.repertoire, bridge, controller.repertoire_path)
-        return
     recorded = controller.spec.evolution.get("simulation")
     mismatch = simulation_mismatch(recorded, bridge, "the controller")
     if mismatch:
@@ -164,24 +185,100 @@ def check_design(controller: Controller) -> None:
         )
 
 
+def start_graph(
+    graph: Graph, args: argparse.Namespace, robot: str, arb_path: str, result_file: str
+) -> subprocess.Popen:
+    """Start the four evorbc nodes and then the bridge, which runs the episode."""
+    sim_time = {"use_sim_time": True}
+    graph.start("laser_sensor", NODES["laser_sensor"], {**sim_time, "sensor_layout": arb_path})
+    graph.start("radar_sensor", NODES["radar_sensor"], {**sim_time, "sensor_layout": arb_path})
+    graph.start(
+        "arbitrator",
+        NODES["arbitrator"],
+        {**sim_time, "arbitrator": arb_path, "repertoire": args.repertoire},
+    )
+    graph.start("primitive_executor", NODES["primitive_executor"], {**sim_time, "robot": robot})
+    return graph.start(
+        "sim_bridge",
+        "sim_bridge.bridge_node",
+        {
+            "maze": args.maze,
+            "robot": robot,
+            "mode": args.mode,
+            "gui": args.gui,
+            "start": args.start,
+            "seed": args.seed,
+            "result_file": result_file,
+        },
+    )
+
+
+def check_start(start: str, seed: int, maze: Maze, robot: str) -> None:
+    """Refuse a ``--start`` the bridge would refuse, or one outside the maze.
+
+    Raises:
+        ConfigError: one line naming ``--start``.
+
+    """
+    clearance = bridge_robot_class(robot).geometry_type().footprint_radius
+    try:
+        # The bridge's own check, so that both refuse the same starts.
+        x, y, _ = SimBridgeNode._start_pose(maze, start, seed, clearance)
+    except StartupError as e:
+        raise ConfigError("--start" + str(e).removeprefix("parameter start")) from None
+    # Far outside, no wall is near, so the clearance check passes; the robot would just
+    # drive the whole episode in empty space.
+    x0, y0, x1, y1 = maze.bounds()
+    if not (x0 < x < x1 and y0 < y < y1):
+        raise ConfigError(
+            f"--start {start}: ({x:.2f}, {y:.2f}) m is outside maze {maze.name}, which spans "
+            f"x {x0:.2f} to {x1:.2f} m and y {y0:.2f} to {y1:.2f} m"
+        )
+
+
+def prepare(args: argparse.Namespace) -> tuple[Controller, Maze, str]:
+    """Check every file and option before any node starts (a node would fail less clearly).
+
+    Returns:
+        The controller the arbitrator node will load, the maze and the picture path.
+
+    """
+    arb_path = args.arbitrator or str(default_arbitrator(args.robot or "4ws-5"))
+    controller = Controller(arb_path, args.repertoire)
+    arb = controller.spec
+    if args.robot and arb.robot != args.robot:
+        raise ConfigError(f"{arb_path}: is for robot {arb.robot}, not --robot {args.robot}")
+    if arb.robot == HEXAPOD:
+        check_design(controller)
+    args.maze = args.maze or ("hexapod" if arb.robot == HEXAPOD else "obstacle")
+    maze = load_named_maze(args.maze)
+    check_start(args.start, args.seed, maze, arb.robot)
+    plot = args.plot or f"{maze.name}-run.png"
+    check_output_file(plot, "--plot", picture=True)
+    if args.result:
+        check_output_file(args.result, "--result")
+    return controller, maze, plot
+
+
 def main(argv=None) -> int:
     """Run one episode through the graph; 0 if it ran (reached or not), 1 on errors."""
     args = parse_args(argv)
     try:
-        arb_path = args.arbitrator or str(default_arbitrator(args.robot or "4ws-5"))
-        # What the arbitrator node will load, checked here so that a mismatch is one line
-        # rather than a node that exits at start-up.
-        controller = Controller(arb_path, args.repertoire)
-        arb = controller.spec
-        if args.robot and arb.robot != args.robot:
-            raise ConfigError(f"{arb_path}: is for robot {arb.robot}, not --robot {args.robot}")
-        if arb.robot == HEXAPOD:
-            check_design(controller)
-        args.maze = args.maze or ("hexapod" if arb.robot == HEXAPOD else "obstacle")
-        maze = load_named_maze(args.maze)
+        return run(args)
     except (ConfigError, ArbitratorError, RepertoireError) as e:
         print(f"evorbc-sim: error: {e}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        print("evorbc-sim: aborted", file=sys.stderr)
+        return 130
+    except Exception as e:
+        return report_unexpected("evorbc-sim", e)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Check, bring the graph up, wait for the episode, report and draw it."""
+    controller, maze, plot = prepare(args)
+    arb, arb_path = controller.spec, controller.arbitrator_path
     if args.result and Path(args.result).exists():
         Path(args.result).unlink()  # never report an earlier run's result as this one's
     env = dict(os.environ)
@@ -189,42 +286,18 @@ def main(argv=None) -> int:
     if args.domain_id is not None:
         env["ROS_DOMAIN_ID"] = str(args.domain_id)
     env.setdefault("PYTHONUNBUFFERED", "1")
-    plot = args.plot or f"{maze.name}-run.png"
     with tempfile.TemporaryDirectory() as tmp:
         result_file = args.result or str(Path(tmp) / "result.json")
         graph = Graph(env, args.quiet)
-        sim_time = {"use_sim_time": True}
-        graph.start("laser_sensor", NODES["laser_sensor"], {**sim_time, "sensor_layout": arb_path})
-        graph.start("radar_sensor", NODES["radar_sensor"], {**sim_time, "sensor_layout": arb_path})
-        graph.start(
-            "arbitrator",
-            NODES["arbitrator"],
-            {**sim_time, "arbitrator": arb_path, "repertoire": args.repertoire},
-        )
-        graph.start(
-            "primitive_executor", NODES["primitive_executor"], {**sim_time, "robot": arb.robot}
-        )
-        bridge = graph.start(
-            "sim_bridge",
-            "sim_bridge.bridge_node",
-            {
-                "maze": args.maze,
-                "robot": arb.robot,
-                "mode": args.mode,
-                "gui": args.gui,
-                "start": args.start,
-                "seed": args.seed,
-                "result_file": result_file,
-            },
-        )
-        if not args.quiet:
-            print(
-                f"evorbc-sim: {arb.kind} controller {arb_path} in maze {maze.name} "
-                f"({args.mode}), ROS_DOMAIN_ID={env.get('ROS_DOMAIN_ID', '0')}",
-                file=sys.stderr,
-            )
-        interrupted = False
+        bridge, interrupted = None, False
         try:
+            bridge = start_graph(graph, args, arb.robot, arb_path, result_file)
+            if not args.quiet:
+                print(
+                    f"evorbc-sim: {arb.kind} controller {arb_path} in maze {maze.name} "
+                    f"({args.mode}), ROS_DOMAIN_ID={env.get('ROS_DOMAIN_ID', '0')}",
+                    file=sys.stderr,
+                )
             while bridge.poll() is None:
                 for name, proc in graph.procs.items():
                     if name != "sim_bridge" and proc.poll() not in (None, 0):
@@ -232,14 +305,15 @@ def main(argv=None) -> int:
                             f"evorbc-sim: error: node {name} exited with status {proc.returncode}",
                             file=sys.stderr,
                         )
-                        graph.stop()
                         return 1
                 time.sleep(0.05)
         except KeyboardInterrupt:
             interrupted = True
             print("\nevorbc-sim: stopping the graph", file=sys.stderr)
         finally:
-            graph.stop()
+            graph.stop()  # also when anything above failed: no node outlives evorbc-sim
+        if bridge is None:
+            return 130
         if not Path(result_file).exists() or (bridge.returncode != 0 and not interrupted):
             print(
                 "evorbc-sim: error: the simulation bridge ended without a result "

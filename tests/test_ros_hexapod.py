@@ -218,19 +218,21 @@ def test_bridge_skips_malformed_trajectories_and_holds_the_last_targets():
         bridge.world.close()
 
 
-def test_evorbc_sim_refuses_a_start_inside_the_legs_reach_and_drops_old_results(
+def test_evorbc_sim_refuses_a_start_inside_the_legs_reach_before_starting_the_graph(
     tmp_path, controller, capsys
 ):
     from sim_bridge.bringup import main
 
     arb_path, rep_path, _, _ = controller
     old = tmp_path / "result.json"
-    old.write_text('{"reached": true}')  # an earlier run's result must not be reported
+    old.write_text('{"reached": true}')
     argv = ["--arbitrator", str(arb_path), "--repertoire", str(rep_path), "--quiet"]
     # The obstacle maze's nominal start is 0.09 m from a wall; the legs reach 0.31 m.
     assert main([*argv, "--maze", "obstacle", "--result", str(old), "--plot", ""]) == 1
-    assert not old.exists()
-    assert "without a result" in capsys.readouterr().err
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("evorbc-sim: error: --start: (")
+    assert "m from a wall of maze obstacle" in err[0]
+    assert old.exists()  # refused before anything ran: nothing of the user's is touched
 
 
 def test_evorbc_sim_refuses_a_repertoire_of_another_design(tmp_path, controller, capsys):

@@ -10,10 +10,15 @@ from pathlib import Path
 import numpy as np
 
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
+from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.config import build_settings, config_dir
 from evorbc_ros.defaults import default_repertoire
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.commands.common import CliError, check_writable, count
+from offline_evolution.commands.common import CliError, count
+from sim_bridge.robots.hexapod import check_simulation, simulation_mismatch
+
+#: How a user lets another repertoire fingerprint or sensor layout through.
+WAIVER = "--allow-mismatch"
 
 
 def add_parsers(sub) -> None:
@@ -67,7 +72,8 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--allow-mismatch",
         action="store_true",
-        help="use a repertoire other than the one the arbitrator was evolved with",
+        help="use a repertoire (of the same robot) or sensor layout other than the one the "
+        "arbitrator was evolved with",
     )
     p.set_defaults(func=cmd_replay)
 
@@ -89,7 +95,7 @@ def resolve_repertoire(
     for path in candidates:
         repertoire = Repertoire.load(path)
         try:
-            warnings = arb.check_repertoire(repertoire, str(path), allow_mismatch)
+            warnings = arb.check_repertoire(repertoire, str(path), allow_mismatch, WAIVER)
             return repertoire, str(path), warnings
         except ArbitratorError as e:
             errors.append(str(e))
@@ -101,6 +107,25 @@ def resolve_repertoire(
     )
 
 
+def check_design(
+    simulation: dict | None,
+    arb: ArbitratorFile,
+    arb_path: Path,
+    repertoire: Repertoire | None,
+    rep_path: str | None,
+) -> None:
+    """Refuse files evolved for another simulated robot than the task's ``simulation``.
+
+    Like ``evorbc-sim``'s check: a repertoire's primitives, or a controller, evolved with
+    other servos, legs or physics would be replayed on a robot they were never tried on.
+    """
+    if repertoire is not None:
+        check_simulation(repertoire, simulation, rep_path)
+    mismatch = simulation_mismatch(arb.evolution.get("simulation"), simulation, "the arbitrator")
+    if mismatch:
+        raise CliError(f"{arb_path}: was evolved for a different robot ({mismatch})")
+
+
 def cmd_replay(args: argparse.Namespace) -> int:
     """Replay and report; optionally draw trajectories and the selection heatmap."""
     from offline_evolution.maze_task.replay import replay, summarise_outcomes
@@ -109,7 +134,12 @@ def cmd_replay(args: argparse.Namespace) -> int:
     arb_path = Path(args.arbitrator)
     if args.episodes < 1 or (args.episodes > 1 and args.start != "random"):
         raise CliError("--episodes N needs N >= 1, and N > 1 needs --start random")
+    for path, option in ((args.plot, "--plot"), (args.heatmap, "--heatmap")):
+        if path:
+            check_output_file(path, option, picture=True)
     arb = ArbitratorFile.load(arb_path)
+    if args.heatmap and arb.kind != "evorbc":
+        raise CliError("--heatmap needs an EvoRBC arbitrator (standard NEAT has no primitives)")
     repertoire, rep_path, warnings = None, None, []
     if arb.kind == "evorbc":
         repertoire, rep_path, warnings = resolve_repertoire(
@@ -129,8 +159,9 @@ def cmd_replay(args: argparse.Namespace) -> int:
         settings = MazeTaskSettings((args.maze,), settings.episode_time, 1, settings.sensors)
     task = make_task(settings, arb.robot)
     try:
+        check_design(task.describe(), arb, arb_path, repertoire, rep_path)
         try:
-            arb.check_sensors(task.layout, settings.sensors, args.allow_mismatch)
+            arb.check_sensors(task.layout, settings.sensors, args.allow_mismatch, WAIVER)
         except ArbitratorError as e:
             raise CliError(str(e)) from None
         if args.start == "random":
@@ -140,7 +171,6 @@ def cmd_replay(args: argparse.Namespace) -> int:
             starts = starts[np.argsort(starts[:, 0], kind="stable")]
         else:
             starts = task.nominal_starts()
-        check_writable(args.plot, args.heatmap)
         outcomes, result = replay(arb, task, starts, repertoire)
     finally:
         task.close()
@@ -187,8 +217,6 @@ def cmd_replay(args: argparse.Namespace) -> int:
 
         plot_trajectories(task, outcomes, result, args.plot, title=arb_path.name)
     if args.heatmap:
-        if arb.kind != "evorbc":
-            raise CliError("--heatmap needs an EvoRBC arbitrator (standard NEAT has no primitives)")
         from offline_evolution.plots.selection import plot_selection
 
         plot_selection(repertoire, arb.mapping, result, args.heatmap, title=arb_path.name)

@@ -1,0 +1,72 @@
+"""What the command-line programs (``evorbc-evolve``, ``evorbc-sim``) share.
+
+* The last-resort report: whatever no check caught ends as one line and status 1, never a
+  traceback (``EVORBC_DEBUG=1`` shows one).
+* Output paths checked before a run, so that a typo costs nothing rather than a whole run.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+from evorbc_ros.config import ConfigError
+
+#: Set (to anything) to get the traceback of an internal error instead of one line.
+DEBUG_VARIABLE = "EVORBC_DEBUG"
+
+
+def report_unexpected(prog: str, error: Exception) -> int:
+    """Report a failure that no check caught as one line; return the exit status 1.
+
+    An :class:`OSError` is the system's word on a file (disk full, permission denied) and
+    is shown as an error about that file; anything else is a bug, shown as an internal
+    error, or raised again when ``EVORBC_DEBUG`` is set.
+    """
+    if isinstance(error, OSError):
+        where = f"{error.filename}: " if error.filename else ""
+        print(f"{prog}: error: {where}{error.strerror or error}", file=sys.stderr)
+        return 1
+    if os.environ.get(DEBUG_VARIABLE):
+        raise error
+    text = " ".join(str(error).split())  # one line, whatever the message holds
+    print(
+        f"{prog}: internal error: {type(error).__name__}: {text} "
+        f"(set {DEBUG_VARIABLE}=1 for a traceback)",
+        file=sys.stderr,
+    )
+    return 1
+
+
+def check_output_file(path: str, option: str, picture: bool = False) -> None:
+    """Refuse an output ``path`` that could not be written, before the work that makes it.
+
+    Missing folders are created (the writer would create them too). With ``picture``, the
+    suffix must name a format matplotlib writes, since it picks the format from it.
+
+    Raises:
+        ConfigError: one line naming ``option``, the path and the problem.
+
+    """
+    target = Path(path)
+    if target.is_dir():
+        raise ConfigError(f"{option} {path}: is a folder, expected a file name")
+    if picture:
+        from matplotlib.backend_bases import FigureCanvasBase
+
+        formats = sorted(FigureCanvasBase.get_supported_filetypes())
+        if target.suffix.lower().lstrip(".") not in formats:
+            raise ConfigError(
+                f"{option} {path}: not a picture format that can be written; "
+                f"end the name in one of .{', .'.join(formats)}"
+            )
+    folder = target.absolute().parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise ConfigError(
+            f"{option} {path}: cannot create folder {folder} ({e.strerror})"
+        ) from None
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ConfigError(f"{option} {path}: folder {folder} is not writable")
