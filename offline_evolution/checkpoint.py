@@ -2,7 +2,9 @@
 
 Checkpoints are loaded with ``allow_pickle=False``: a checkpoint is data, never code, so a
 file from elsewhere cannot run anything. They are written atomically, so an interruption
-while saving leaves the previous checkpoint intact.
+while saving leaves the previous checkpoint intact. NEAT runs keep theirs as plain JSON
+(:func:`load_json_checkpoint`). Any file may be given as a checkpoint by mistake, so
+``--restart`` deletes only one that declares the run's kind (:func:`discard_checkpoint`).
 """
 
 from __future__ import annotations
@@ -22,7 +24,15 @@ _HEADER = "__header__"
 
 
 class CheckpointError(ValueError):
-    """A checkpoint cannot be used; the message names the file and the reason."""
+    """A checkpoint cannot be used; the message names the file and the reason.
+
+    ``discardable`` is False when the file is not recognisably a checkpoint of the run's
+    kind (another file given as ``--checkpoint`` by mistake): it must not be deleted.
+    """
+
+    def __init__(self, message: str, discardable: bool = True) -> None:
+        super().__init__(message)
+        self.discardable = discardable
 
 
 class Interrupted(Exception):
@@ -41,25 +51,118 @@ def save_checkpoint(path: str | os.PathLike, header: dict, arrays: dict[str, np.
     atomic_write(path, lambda f: f.write(buf.getvalue()), binary=True)
 
 
+#: What reading a damaged or foreign ``.npz`` can raise.
+_READ_ERRORS = (OSError, ValueError, KeyError, zipfile.BadZipFile, EOFError)
+
+
+def _reason(e: Exception) -> str:
+    # numpy's advice about allow_pickle would invite loading the pickle: never do that.
+    return "it holds pickled objects" if "pickle" in str(e) else str(e)
+
+
+def _header(data, source: str) -> dict:
+    """The JSON header of an open ``.npz``; CheckpointError (not discardable) if none."""
+    if _HEADER not in data.files:
+        raise CheckpointError(f"{source}: not a checkpoint (no header)", discardable=False)
+    try:
+        header = json.loads(str(data[_HEADER]))
+    except _READ_ERRORS as e:
+        raise CheckpointError(
+            f"{source}: not a checkpoint ({_reason(e)})", discardable=False
+        ) from None
+    if not isinstance(header, dict):
+        raise CheckpointError(f"{source}: not a checkpoint (bad header)", discardable=False)
+    return header
+
+
+def _open(path: str | os.PathLike):
+    """``np.load`` of a file that is an ``.npz`` archive, else CheckpointError."""
+    source = str(path)
+    if not Path(path).exists():
+        raise CheckpointError(f"{source}: no such checkpoint", discardable=False)
+    if Path(path).is_dir():
+        raise CheckpointError(f"{source}: is a folder, expected a checkpoint", discardable=False)
+    # Checked first: numpy reads any other file as a pickle and then complains about
+    # allow_pickle, which says nothing useful about a JSON or text file.
+    if not zipfile.is_zipfile(path):
+        raise CheckpointError(
+            f"{source}: not a checkpoint (not an .npz archive)", discardable=False
+        )
+    try:
+        return np.load(path, allow_pickle=False)
+    except _READ_ERRORS as e:
+        raise CheckpointError(
+            f"{source}: not a checkpoint ({_reason(e)})", discardable=False
+        ) from None
+
+
 def load_checkpoint(path: str | os.PathLike) -> tuple[dict, dict[str, np.ndarray]]:
     """Read a checkpoint written by :func:`save_checkpoint`.
 
     Raises:
-        CheckpointError: the file is missing, truncated or not a checkpoint.
+        CheckpointError: the file is missing or not a checkpoint (then not
+            ``discardable``: it may be someone's file given by mistake), or a checkpoint
+            whose arrays cannot be read.
 
     """
-    source = str(path)
-    if not Path(path).exists():
-        raise CheckpointError(f"{source}: no such checkpoint")
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {k: data[k] for k in data.files}
-        header = json.loads(str(arrays.pop(_HEADER)))
-    except (OSError, ValueError, KeyError, zipfile.BadZipFile, EOFError) as e:
-        raise CheckpointError(f"{source}: not a usable checkpoint ({e})") from None
-    if not isinstance(header, dict):
-        raise CheckpointError(f"{source}: not a usable checkpoint (bad header)")
+    with _open(path) as data:
+        header = _header(data, str(path))
+        try:
+            arrays = {k: data[k] for k in data.files if k != _HEADER}
+        except _READ_ERRORS as e:
+            raise CheckpointError(f"{path}: not a usable checkpoint ({_reason(e)})") from None
     return header, arrays
+
+
+def load_json_checkpoint(path: str | os.PathLike) -> dict:
+    """Read a JSON checkpoint (NEAT runs write one: genomes are nested records, not arrays).
+
+    Raises:
+        CheckpointError: unreadable, not JSON or not a JSON object (not ``discardable``).
+
+    """
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as e:
+        raise CheckpointError(f"{path}: cannot read ({e.strerror})", discardable=False) from None
+    except (UnicodeDecodeError, RecursionError, json.JSONDecodeError):
+        raise CheckpointError(f"{path}: not a checkpoint (not JSON)", discardable=False) from None
+    if not isinstance(data, dict):
+        raise CheckpointError(f"{path}: not a checkpoint (not a JSON object)", discardable=False)
+    return data
+
+
+def checkpoint_kind(path: str | os.PathLike) -> str | None:
+    """The ``kind`` a checkpoint (``.npz`` or JSON) declares; None for any other file."""
+    try:
+        if zipfile.is_zipfile(path):
+            with _open(path) as data:
+                header = _header(data, str(path))  # the arrays may be damaged
+        else:
+            header = load_json_checkpoint(path)
+    except CheckpointError:
+        return None
+    kind = header.get("kind")
+    return kind if isinstance(kind, str) else None
+
+
+def discard_checkpoint(path: str | os.PathLike, kind: str, what: str) -> None:
+    """Delete the checkpoint at ``path`` (``--restart``) if it is recognisably one.
+
+    Args:
+        kind: the ``kind`` the run's checkpoints declare; any other file is left alone.
+        what: what such a checkpoint is called in the message ("MAP-Elites checkpoint").
+
+    Raises:
+        CheckpointError: ``path`` holds something else, which is left as it is.
+
+    """
+    path = Path(path)
+    if not path.exists():
+        return
+    if path.is_dir() or checkpoint_kind(path) != kind:
+        raise CheckpointError(f"{path}: not a {what}", discardable=False)
+    path.unlink()
 
 
 def settings_mismatch(saved: dict, current: dict, where: str = "the checkpoint") -> str | None:

@@ -124,13 +124,15 @@ def test_bad_yaml_and_corrupt_checkpoint(tmp_path, capsys):
         capsys, "repertoire", "--config", str(cfg), "--out", str(tmp_path / "r.json")
     )
     assert code == 1 and f"{cfg}: invalid YAML at line 2" in err
+    # Not recognisably a checkpoint: maybe someone's file, so even --restart keeps it.
     (tmp_path / "r.json.checkpoint.npz").write_bytes(b"not a checkpoint")
     code, _, err = run_cli(capsys, "repertoire", *SMALL, "--out", str(tmp_path / "r.json"))
-    assert code == 1 and "not a usable checkpoint" in err and "--restart" in err
+    assert code == 1 and "not a checkpoint (not an .npz archive)" in err
     code, _, err = run_cli(
         capsys, "repertoire", *SMALL, "--restart", "--out", str(tmp_path / "r.json")
     )
-    assert code == 0, err
+    assert code == 1 and "--restart does not delete it" in err
+    assert (tmp_path / "r.json.checkpoint.npz").read_bytes() == b"not a checkpoint"
 
 
 def test_ctrl_c_saves_a_checkpoint_and_the_same_command_resumes(tmp_path):

@@ -84,7 +84,7 @@ def test_checkpoint_of_another_run_is_refused(tmp_path, small_neat_file, small_r
             checkpoint=ckpt,
         )
     ckpt.write_text(ckpt.read_text()[:500])
-    with pytest.raises(CheckpointError, match="not a usable checkpoint"):
+    with pytest.raises(CheckpointError, match="not a checkpoint"):
         evolve(s, small_repertoire, checkpoint=ckpt)
 
 

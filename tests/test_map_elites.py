@@ -147,7 +147,7 @@ def test_checkpoint_of_another_run_is_refused(tmp_path):
     with pytest.raises(CheckpointError, match="seed is 7 in the checkpoint but 9 now"):
         generate_repertoire(small_settings(seed=9), checkpoint=ckpt)
     ckpt.write_bytes(ckpt.read_bytes()[:100])
-    with pytest.raises(CheckpointError, match="not a usable checkpoint"):
+    with pytest.raises(CheckpointError, match="not a checkpoint"):
         generate_repertoire(small_settings(), checkpoint=ckpt)
 
 

@@ -35,6 +35,7 @@ from offline_evolution.arbitrator.neat_state import (
     genome_to_dict,
     population_from_dict,
     population_to_dict,
+    require,
 )
 from offline_evolution.arbitrator.selection import (
     HallOfFame,
@@ -46,6 +47,7 @@ from offline_evolution.checkpoint import (
     CheckpointError,
     Interrupted,
     check_same_robot,
+    load_json_checkpoint,
     settings_mismatch,
 )
 from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings, make_task
@@ -273,28 +275,57 @@ class Evolution:
         """Continue from a checkpoint of the same settings; returns its elapsed seconds.
 
         Raises:
-            CheckpointError: unreadable, not a NEAT checkpoint, or another run's.
+            CheckpointError: unreadable, not a NEAT checkpoint (not ``discardable``), or
+                another run's, or with contents no run writes (named in the message).
         """
-        try:
-            data = json.loads(Path(path).read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-            raise CheckpointError(f"{path}: not a usable checkpoint ({e})") from None
-        if not isinstance(data, dict) or data.get("kind") != CHECKPOINT_KIND:
-            raise CheckpointError(f"{path}: not a NEAT evolution checkpoint")
-        mismatch = settings_mismatch(data.get("settings", {}), self.settings.as_dict())
+        data = load_json_checkpoint(path)
+        if data.get("kind") != CHECKPOINT_KIND:
+            raise CheckpointError(f"{path}: not a NEAT evolution checkpoint", discardable=False)
+        if not isinstance(data.get("settings"), dict):
+            raise CheckpointError(f"{path}: not a usable checkpoint (settings missing)")
+        mismatch = settings_mismatch(data["settings"], self.settings.as_dict())
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
         check_same_robot(path, data.get("simulation"), self.simulation)
         try:
-            self.population = population_from_dict(data["population"], self.config)
-            self.best = data["best"]
-            self.best_generation = int(data["best_generation"])
-            self.best_reached = int(data["best_reached"])
-            self.hall = HallOfFame.from_dict(data["hall_of_fame"])
-            self.history = [GenerationStats(**h) for h in data["history"]]
-            return float(data["elapsed"])
+            self.population = population_from_dict(require(data, "population", dict), self.config)
+            return self._restore_record(data)
         except (KeyError, TypeError, ValueError) as e:
-            raise CheckpointError(f"{path}: not a usable checkpoint ({e!r})") from None
+            problem = str(e) if isinstance(e, ValueError) else repr(e)
+            raise CheckpointError(f"{path}: not a usable checkpoint ({problem})") from None
+
+    def _restore_record(self, data: dict) -> float:
+        """Restore the best genome, hall of fame and history; the run's elapsed seconds."""
+        generation = self.generation
+        if not 0 <= generation <= self.settings.generations:
+            raise ValueError(
+                f"population.generation must be from 0 to the run's "
+                f"{self.settings.generations}, got {generation}"
+            )
+        best = require(data, "best", dict, none_ok=generation == 0)
+        if best is not None:
+            genome_from_dict(best, self.config, "best.")
+            require(best, "fitness", float, "best.")
+        self.best = best
+        self.best_generation = require(data, "best_generation", int)
+        self.best_reached = require(data, "best_reached", int)
+        hall = require(data, "hall_of_fame", dict)
+        for part in ("top", "recent"):
+            for i, g in enumerate(require(hall, part, list, "hall_of_fame.")):
+                genome_from_dict(g, self.config, f"hall_of_fame.{part}[{i}].")
+                require(g, "fitness", float, f"hall_of_fame.{part}[{i}].")
+        self.hall = HallOfFame.from_dict(hall)
+        history = require(data, "history", list)
+        if len(history) != generation:
+            raise ValueError(f"history has {len(history)} generations, the population {generation}")
+        kinds = {
+            f.name: float if f.type == "float" else int for f in dataclasses.fields(GenerationStats)
+        }
+        for i, h in enumerate(history):
+            for key, kind in kinds.items():
+                require(h, key, kind, f"history[{i}].")
+        self.history = [GenerationStats(**{k: h[k] for k in kinds}) for h in history]
+        return float(require(data, "elapsed", float))
 
 
 def evolve(
@@ -307,6 +338,7 @@ def evolve(
     should_stop: Callable[[], bool] | None = None,
     workers: int | None = None,
     repertoire_source: str = "the repertoire",
+    keep_checkpoint: bool = False,
 ) -> EvolutionResult:
     """Run NEAT on the maze task to the last generation.
 
@@ -314,16 +346,20 @@ def evolve(
         settings: the run (see :class:`EvolutionSettings`).
         repertoire: the repertoire an EvoRBC arbitrator chooses from.
         checkpoint: resumed from if it exists, written every ``checkpoint_every``
-            generations, removed at the end.
+            generations, removed at the end (unless ``keep_checkpoint``).
         progress: called after every generation.
         should_stop: polled after every generation; True saves and raises
             :class:`~offline_evolution.repertoire.map_elites.Interrupted`.
         workers: processes that run episodes (PyBullet robots; default: every core). The
             result does not depend on it.
         repertoire_source: how errors name the repertoire (its file).
+        keep_checkpoint: save the finished run to ``checkpoint`` and keep it, for a caller
+            that removes it only once the arbitrator file is safely written; the same
+            call then only post-evaluates again (seeded: the same result).
 
     Raises:
         RepertoireError: the repertoire was evolved for another simulated robot.
+        CheckpointError: the checkpoint exists but belongs to another run or is corrupt.
     """
     run = Evolution(settings, repertoire, workers, repertoire_source)
     try:
@@ -331,6 +367,7 @@ def evolve(
         if checkpoint is not None and os.path.exists(checkpoint):
             elapsed = run.restore(checkpoint)
         start = time.perf_counter() - elapsed
+        saved = run.generation
         while not run.finished:
             stats = run.step()
             if progress is not None:
@@ -339,11 +376,15 @@ def evolve(
             due = checkpoint is not None and run.generation % max(1, checkpoint_every) == 0
             if checkpoint is not None and (due or stop) and not run.finished:
                 run.save(checkpoint, time.perf_counter() - start)
+                saved = run.generation
             if stop:
                 raise Interrupted(run.generation, None if checkpoint is None else str(checkpoint))
-        if checkpoint is not None and os.path.exists(checkpoint):
+        if checkpoint is not None and keep_checkpoint and saved != run.generation:
+            run.save(checkpoint, time.perf_counter() - start)
+        result = run.result(time.perf_counter() - start)
+        if checkpoint is not None and not keep_checkpoint and os.path.exists(checkpoint):
             os.remove(checkpoint)
-        return run.result(time.perf_counter() - start)
+        return result
     finally:
         run.task.close()
 

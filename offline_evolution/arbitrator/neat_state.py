@@ -5,15 +5,86 @@ checkpoint file handed over by someone else could run anything. This module writ
 everything a run needs to continue exactly where it stopped (genomes with their genes in
 order, species, counters, the innovation tracker, the adaptive compatibility threshold
 and Python's random state) as JSON, and rebuilds the objects from it.
+
+A checkpoint is a file like any other: before anything is rebuilt, its structure and
+types are checked, and a problem is raised as a ``ValueError`` that names the entry
+(``population.genomes[3].nodes[0].bias must be a number``).
 """
 
 from __future__ import annotations
 
+import math
 import random
 from itertools import count
 
 import neat
+from neat.attributes import BoolAttribute, FloatAttribute, StringAttribute
 from neat.species import Species
+
+_KINDS = {int: "a whole number", float: "a number", str: "a string", bool: "true or false"}
+_KINDS.update({list: "a list", dict: "an object"})
+
+
+def require(data: dict, key: str, kind: type, where: str = "", none_ok: bool = False):
+    """``data[key]`` if it is of ``kind`` (``float``: any finite number).
+
+    Raises:
+        ValueError: ``<where><key> is missing`` or ``... must be <kind>, got <value>``.
+
+    """
+    if not isinstance(data, dict):
+        raise ValueError(f"{where.rstrip('.') or 'the checkpoint'} must be an object")
+    if key not in data:
+        raise ValueError(f"{where}{key} is missing")
+    value = data[key]
+    if value is None and none_ok:
+        return None
+    if kind is float:
+        ok = isinstance(value, (int, float)) and math.isfinite(value)
+    else:
+        ok = isinstance(value, kind)
+    # bool is an int subclass; true/false where a number belongs is a mistake.
+    if not ok or (isinstance(value, bool) and kind is not bool):
+        raise ValueError(f"{where}{key} must be {_KINDS[kind]}, got {value!r:.40}")
+    return value
+
+
+def _attribute_kind(attribute) -> type:
+    kinds = {BoolAttribute: bool, FloatAttribute: float, StringAttribute: str}
+    return next(k for cls, k in kinds.items() if isinstance(attribute, cls))
+
+
+def check_genome_dict(data: dict, config: neat.Config, where: str = "genome.") -> None:
+    """Check that ``data`` is a genome :func:`genome_to_dict` could have written.
+
+    Raises:
+        ValueError: naming the first entry that is missing, of the wrong type, or an
+            activation or aggregation the NEAT settings do not offer.
+
+    """
+    gc = config.genome_config
+    require(data, "key", int, where)
+    require(data, "fitness", float, where, none_ok=True)
+    nodes = set()
+    for part, gene_type in (("nodes", gc.node_gene_type), ("connections", gc.connection_gene_type)):
+        for i, gene in enumerate(require(data, part, list, where)):
+            w = f"{where}{part}[{i}]."
+            if part == "nodes":
+                nodes.add(require(gene, "key", int, w))
+            else:
+                key = require(gene, "key", list, w)
+                if len(key) != 2 or not all(k in nodes or k in gc.input_keys for k in key):
+                    raise ValueError(f"{w}key must join two nodes of the genome, got {key}")
+                require(gene, "innovation", int, w)
+            for attribute in gene_type._gene_attributes:
+                value = require(gene, attribute.name, _attribute_kind(attribute), w)
+                if isinstance(attribute, StringAttribute):
+                    options = getattr(gc, attribute.options_name)
+                    if value not in options:
+                        raise ValueError(f"{w}{attribute.name} must be one of {options}")
+    missing = set(gc.output_keys) - nodes
+    if missing:
+        raise ValueError(f"{where}nodes lacks the output nodes {sorted(missing)}")
 
 
 def genome_to_dict(genome) -> dict:
@@ -35,8 +106,14 @@ def genome_to_dict(genome) -> dict:
     }
 
 
-def genome_from_dict(data: dict, config: neat.Config):
-    """Rebuild a genome written by :func:`genome_to_dict`."""
+def genome_from_dict(data: dict, config: neat.Config, where: str = "genome."):
+    """Rebuild a genome written by :func:`genome_to_dict`.
+
+    Raises:
+        ValueError: ``data`` is not such a genome (see :func:`check_genome_dict`).
+
+    """
+    check_genome_dict(data, config, where)
     gc = config.genome_config
     genome = config.genome_type(data["key"])
     genome.fitness = data["fitness"]
@@ -105,14 +182,50 @@ def population_to_dict(pop: neat.Population) -> dict:
     }
 
 
+def _check_population_dict(data: dict) -> None:
+    """Check the counters and species of a population dict (the genomes are checked apart)."""
+    w = "population."
+    require(data, "generation", int, w)
+    for key in ("next_species_key", "next_genome_key"):
+        require(data, key, int, w)
+    require(data, "next_node_key", int, w, none_ok=True)
+    require(data, "compatibility_threshold", float, w)
+    require(data, "random_state", list, w)
+    require(data, "genome_to_species", list, w)
+    innovation = require(data, "innovation", dict, w)
+    require(innovation, "global_counter", int, f"{w}innovation.")
+    require(innovation, "generation", list, f"{w}innovation.")
+    for i, s in enumerate(require(data, "species", list, w)):
+        ws = f"{w}species[{i}]."
+        for key in ("key", "created", "last_improved", "representative"):
+            require(s, key, int, ws)
+        for key in ("fitness", "adjusted_fitness"):
+            require(s, key, float, ws, none_ok=True)
+        require(s, "members", list, ws)
+        require(s, "fitness_history", list, ws)
+    if data["generation"] < 0:
+        raise ValueError(f"{w}generation must not be negative, got {data['generation']}")
+
+
 def population_from_dict(data: dict, config: neat.Config) -> neat.Population:
-    """Rebuild a population written by :func:`population_to_dict` (with the same config)."""
+    """Rebuild a population written by :func:`population_to_dict` (with the same config).
+
+    Raises:
+        ValueError: ``data`` is not such a population; the message names the entry.
+        KeyError, TypeError: an entry refers to a genome that is not there, or a
+            counter or the random state has the wrong form.
+
+    """
+    _check_population_dict(data)
     genomes = {}
-    for g in data["genomes"]:
-        genome = genome_from_dict(g, config)
+    for i, g in enumerate(require(data, "genomes", list, "population.")):
+        genome = genome_from_dict(g, config, f"population.genomes[{i}].")
         genomes[genome.key] = genome
     species_set = config.species_set_type(config.species_set_config, neat.reporting.ReporterSet())
-    for s in data["species"]:
+    for i, s in enumerate(data["species"]):
+        unknown = {s["representative"], *s["members"]} - set(genomes)
+        if unknown:
+            raise ValueError(f"population.species[{i}] holds genomes not in the population")
         species = Species(s["key"], s["created"])
         species.last_improved = s["last_improved"]
         species.representative = genomes[s["representative"]]

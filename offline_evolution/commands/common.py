@@ -7,6 +7,7 @@ import math
 import os
 import signal
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 EXIT_ERROR = 1
@@ -106,3 +107,44 @@ def check_writable(*paths) -> None:
 def default_checkpoint(out: Path, given: str | None, suffix: str) -> Path:
     """The checkpoint path: ``given``, or ``OUT<suffix>`` next to the output."""
     return Path(given) if given else out.with_name(out.name + suffix)
+
+
+def _identity(path: str | os.PathLike):
+    """What makes two names one file: device and inode if it exists, else the full path."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return Path(path).resolve()
+    return (st.st_dev, st.st_ino)
+
+
+def check_distinct(files: dict[str, str | os.PathLike | None]) -> None:
+    """Refuse two of ``files`` (option -> path; None skipped) that name the same file.
+
+    Inputs count too: an output written over an input (or over another output, or the
+    checkpoint) would destroy it.
+    """
+    seen: dict = {}
+    for option, path in files.items():
+        if path is None:
+            continue
+        other = seen.setdefault(_identity(path), option)
+        if other != option:
+            raise CliError(f"{option} {path} is the same file as {other}; use another file")
+
+
+def write_then_discard(checkpoint: Path, write: Callable[[], None]) -> None:
+    """Write a finished run's files, then delete its checkpoint.
+
+    The run saved its finished state to ``checkpoint``; if writing fails it is kept and
+    the one-line error says so, and the same command then only writes the files.
+    """
+    try:
+        write()
+    except (OSError, ValueError, CliError) as e:
+        where = f"{e.filename}: {e.strerror or e}" if getattr(e, "filename", None) else str(e)
+        raise CliError(
+            f"{where}; the finished run is kept in {checkpoint}: run the same command "
+            "again to write its files"
+        ) from None
+    checkpoint.unlink(missing_ok=True)

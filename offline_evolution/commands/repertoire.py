@@ -8,17 +8,18 @@ import time
 from pathlib import Path
 
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.checkpoint import CheckpointError, Interrupted
+from offline_evolution.checkpoint import CheckpointError, Interrupted, discard_checkpoint
 from offline_evolution.commands.common import (
     EXIT_INTERRUPTED,
-    EXIT_USAGE,
     CliError,
     StopOnSignal,
     add_workers_option,
+    check_distinct,
     check_writable,
     count,
     default_checkpoint,
     positive_float,
+    write_then_discard,
 )
 
 
@@ -126,31 +127,54 @@ class _ProgressPrinter:
         )
 
 
+#: Setting key -> the option that overrides it.
+OPTIONS = {
+    "robot": "--robot",
+    "metric": "--metric",
+    "bin_size": "--bin-size",
+    "eval_time": "--eval-time",
+    "initial_batch": "--initial-batch",
+    "batch_size": "--batch-size",
+    "iterations": "--iterations",
+    "seed": "--seed",
+    "archive": "--archive",
+    "variation": "--variation",
+}
+
+
 def cmd_repertoire(args: argparse.Namespace) -> int:
     """Generate a repertoire, write it (and optionally a plot and CSV), print a summary."""
-    from offline_evolution.repertoire.map_elites import generate_repertoire
-    from offline_evolution.repertoire.settings import load_settings
-
-    settings = load_settings(
-        args.config,
-        robot=args.robot,
-        metric=args.metric,
-        bin_size=args.bin_size,
-        eval_time=args.eval_time,
-        initial_batch=args.initial_batch,
-        batch_size=args.batch_size,
-        iterations=args.iterations,
-        seed=args.seed,
-        archive=args.archive,
-        variation=args.variation,
+    from offline_evolution.repertoire.map_elites import CHECKPOINT_KIND, generate_repertoire
+    from offline_evolution.repertoire.settings import (
+        SettingError,
+        blame,
+        load_settings,
+        settings_path,
     )
-    if settings.initial_batch < 1 or settings.batch_size < 1:
-        raise CliError("--initial-batch and --batch-size must be at least 1", EXIT_USAGE)
+
     out = Path(args.out)
     checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.npz")
-    if args.restart and checkpoint.exists():
-        checkpoint.unlink()
+    check_distinct(
+        {
+            "--out": out,
+            "--plot": args.plot,
+            "--csv": args.csv,
+            "--checkpoint": checkpoint,
+            "--config": args.config,
+        }
+    )
+    given = {key: option for key, option in OPTIONS.items() if getattr(args, key) is not None}
+    config = settings_path(args.config, args.robot)
+    settings = load_settings(config, options=given, **{k: getattr(args, k) for k in OPTIONS})
     check_writable(out, args.plot, args.csv)
+    if args.restart:
+        try:
+            discard_checkpoint(checkpoint, CHECKPOINT_KIND, "MAP-Elites checkpoint")
+        except CheckpointError as e:
+            raise CliError(
+                f"{e}, so --restart does not delete it; remove it yourself or choose "
+                "another --checkpoint"
+            ) from None
     stop = StopOnSignal("batch")
     previous_handlers = stop.install()
     start = time.perf_counter()
@@ -162,9 +186,14 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
             progress=_ProgressPrinter(args.quiet),
             should_stop=stop,
             workers=args.workers or None,
+            keep_checkpoint=True,
         )
+    except SettingError as e:
+        raise blame(e, config, given) from None
     except CheckpointError as e:
-        raise CliError(f"{e}; use --restart to discard it") from None
+        if e.discardable:
+            raise CliError(f"{e}; use --restart to discard it") from None
+        raise CliError(f"{e}; choose another --checkpoint") from None
     except Interrupted as e:
         raise CliError(
             f"interrupted after iteration {e.iteration}; finished work is saved in "
@@ -174,13 +203,7 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
     finally:
         stop.restore(previous_handlers)
     elapsed = time.perf_counter() - start
-    repertoire.save(out)
-    if args.plot:
-        from offline_evolution.plots.repertoire import plot_repertoire
-
-        plot_repertoire(repertoire, args.plot)
-    if args.csv:
-        repertoire.to_csv(args.csv)
+    write_then_discard(checkpoint, lambda: _write(repertoire, out, args.plot, args.csv))
     s = repertoire.summary()
     print(
         f"{repertoire.robot} repertoire: {s['count']} primitives, mean quality "
@@ -191,10 +214,23 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
     return 0
 
 
+def _write(repertoire: Repertoire, out: Path, plot: str | None, csv: str | None) -> None:
+    """Write the repertoire file and the plot and CSV asked for."""
+    repertoire.save(out)
+    if plot:
+        from offline_evolution.plots.repertoire import plot_repertoire
+
+        plot_repertoire(repertoire, plot)
+    if csv:
+        repertoire.to_csv(csv)
+
+
 def cmd_export_csv(args: argparse.Namespace) -> int:
     """Convert a repertoire file to CSV."""
     repertoire = Repertoire.load(args.repertoire)
     out = Path(args.out) if args.out else Path(args.repertoire).with_suffix(".csv")
+    out_option = "--out" if args.out else "the default --out"
+    check_distinct({"REPERTOIRE": args.repertoire, out_option: out})
     check_writable(out)
     repertoire.to_csv(out)
     print(f"{len(repertoire)} primitives -> {out}")

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 import numpy as np
 import ribs
 
-from evorbc_ros.config import ConfigError
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.checkpoint import (
     CheckpointError,
@@ -34,8 +33,9 @@ from offline_evolution.repertoire.archive import (
     grid_layout,
     make_archive,
 )
+from offline_evolution.repertoire.checkpoint_contents import arrays_problem, header_problem
 from offline_evolution.repertoire.emitter import IsoLineDDEmitter, PaperMutationEmitter
-from offline_evolution.repertoire.settings import MapElitesSettings
+from offline_evolution.repertoire.settings import MapElitesSettings, SettingError
 from sim_bridge.robots import SimulatedRobot, make_robot
 from sim_bridge.robots.base import control_steps
 
@@ -84,7 +84,8 @@ class MapElites:
         try:
             control_steps(settings.eval_time, self.robot.control_period)
         except ValueError as e:
-            raise ConfigError(f"eval_time of {self.robot.name}: {e}") from None
+            self.close()
+            raise SettingError("eval_time", f"{e} (robot {self.robot.name})") from None
         self.metric = quality_metric(settings.metric)
         reach = self.robot.max_reach(settings.eval_time)
         if settings.archive == "cvt":
@@ -115,7 +116,12 @@ class MapElites:
 
     def tell(self, genes: np.ndarray, outcome) -> None:
         """Score a batch's outcome and add the primitives that count to the archive."""
-        quality = self.metric(outcome)
+        try:
+            quality = self.metric(outcome)
+        except ValueError as e:
+            # The only metric that can refuse an outcome is circular+tilt on a robot that
+            # reports no tilt: a setting that does not suit the robot.
+            raise SettingError("metric", f"must suit robot {self.robot.name} ({e})") from None
         behaviour = outcome.displacement
         low, high = np.asarray(self.layout["low"]), np.asarray(self.layout["high"])
         # NaN quality: discarded by the metric (a legged robot fell over). A behaviour
@@ -227,8 +233,11 @@ class MapElites:
         """
         header, arrays = load_checkpoint(path)
         if header.get("kind") != CHECKPOINT_KIND:
-            raise CheckpointError(f"{path}: not a MAP-Elites checkpoint")
-        mismatch = settings_mismatch(header.get("settings", {}), self.settings.as_dict())
+            raise CheckpointError(f"{path}: not a MAP-Elites checkpoint", discardable=False)
+        saved = header.get("settings")
+        if not isinstance(saved, dict):
+            raise CheckpointError(f"{path}: not a usable checkpoint (settings missing)")
+        mismatch = settings_mismatch(saved, self.settings.as_dict())
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
         check_same_robot(path, header.get("simulation"), self._simulation().get("simulation"))
@@ -238,21 +247,37 @@ class MapElites:
             # k-means is seeded, but a different BLAS or scikit-learn could still move
             # the centroids; elites filed under other cells would silently change the run.
             raise CheckpointError(f"{path}: its CVT centroids differ from this run's")
-        try:
-            self.archive.clear()
-            if len(arrays["objective"]):
-                self.archive.add(
-                    arrays["solution"],
-                    arrays["objective"],
-                    arrays["measures"],
-                    **{k: arrays[k] for k in EXTRA_FIELDS},
-                )
-            self.emitter.set_state(header["emitter"])
-            self.batches_done = int(header["batches_done"])
-            self.evaluations = int(header["evaluations"])
-            self.discarded = int(header["discarded"])
-        except (KeyError, ValueError, TypeError) as e:
-            raise CheckpointError(f"{path}: not a usable checkpoint ({e})") from None
+        d = len(self.robot.parameter_specs)
+        problem = header_problem(header, self.settings) or arrays_problem(
+            arrays, d, self.layout, header["evaluations"]
+        )
+        if problem is None:
+            try:
+                problem = self._refill(header, arrays)
+            except (KeyError, ValueError, TypeError) as e:
+                problem = str(e)
+        if problem:
+            raise CheckpointError(f"{path}: not a usable checkpoint ({problem})")
+
+    def _refill(self, header: dict, arrays: dict[str, np.ndarray]) -> str | None:
+        """Put a checked checkpoint's elites and counters back; a problem found, or None."""
+        self.archive.clear()
+        n = len(arrays["objective"])
+        if n:
+            self.archive.add(
+                arrays["solution"],
+                arrays["objective"],
+                arrays["measures"],
+                **{k: arrays[k] for k in EXTRA_FIELDS},
+            )
+        if len(self.archive) != n:
+            # MAP-Elites keeps one elite per cell: two in a cell were not written by a run.
+            return f"{n} elites in {len(self.archive)} cells"
+        self.emitter.set_state(header["emitter"])
+        self.batches_done = header["batches_done"]
+        self.evaluations = header["evaluations"]
+        self.discarded = header["discarded"]
+        return None
 
 
 def make_emitter(archive, settings: MapElitesSettings) -> PaperMutationEmitter:
@@ -284,6 +309,7 @@ def generate_repertoire(
     progress: Callable[[Progress], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
     workers: int | None = None,
+    keep_checkpoint: bool = False,
 ) -> Repertoire:
     """Run MAP-Elites to the end and return the repertoire.
 
@@ -292,15 +318,20 @@ def generate_repertoire(
         robot: the simulated robot; by default the one ``settings.robot`` names.
         checkpoint: file to resume from if it exists, and to save to every
             ``checkpoint_every`` batches or ``checkpoint_seconds`` of wall time,
-            whichever comes first; removed once the run finishes.
+            whichever comes first; removed once the run finishes (unless
+            ``keep_checkpoint``).
         progress: called after every batch with a :class:`Progress`.
         should_stop: polled after every batch; if it returns True the run saves its
             checkpoint and raises :class:`Interrupted`.
         workers: processes that evaluate primitives (PyBullet robots; default: every
             core). The result does not depend on it.
+        keep_checkpoint: save the finished run to ``checkpoint`` and keep it, for a caller
+            that removes it only once the repertoire is safely written; the same call
+            then just returns the repertoire again.
 
     Raises:
         CheckpointError: the checkpoint exists but belongs to another run or is corrupt.
+        SettingError: a setting does not suit the robot (eval_time, metric).
         Interrupted: ``should_stop`` asked to stop.
 
     """
@@ -310,7 +341,7 @@ def generate_repertoire(
         if checkpoint is not None and os.path.exists(checkpoint):
             run.restore(checkpoint)
             resumed_from = run.iteration
-        at_start = run.evaluations
+        at_start = saved = run.evaluations
         start = last_save = time.perf_counter()
         while not run.finished:
             run.step()
@@ -324,12 +355,15 @@ def generate_repertoire(
             stop = should_stop is not None and should_stop() and not run.finished
             if checkpoint is not None and (due or stop) and not run.finished:
                 run.save(checkpoint)
-                last_save = now
+                last_save, saved = now, run.evaluations
             if stop:
                 raise Interrupted(run.iteration, None if checkpoint is None else str(checkpoint))
-        if checkpoint is not None and os.path.exists(checkpoint):
+        if checkpoint is not None and keep_checkpoint and saved != run.evaluations:
+            run.save(checkpoint)
+        repertoire = run.repertoire()
+        if checkpoint is not None and not keep_checkpoint and os.path.exists(checkpoint):
             os.remove(checkpoint)
-        return run.repertoire()
+        return repertoire
     finally:
         run.close()
 

@@ -8,10 +8,18 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import typing
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from evorbc_ros.config import build_settings, config_dir, load_yaml_mapping, setting
+from evorbc_ros.config import (
+    ConfigError,
+    build_settings,
+    config_dir,
+    load_yaml_mapping,
+    setting,
+)
 from offline_evolution.quality import METRICS
 from sim_bridge.robots import ROBOT_NAMES
 
@@ -62,19 +70,77 @@ def default_settings_file(robot: str) -> Path:
     return config_dir() / "repertoire" / f"{robot_family(robot)}.yaml"
 
 
-def load_settings(path: str | os.PathLike | None = None, **overrides) -> MapElitesSettings:
+class SettingError(ConfigError):
+    """A well-formed setting that does not suit the robot (checked once the robot is built).
+
+    ``key`` names the setting and ``problem`` says what is wrong, so the caller can blame
+    the command-line option or the settings file it came from (:func:`blame`).
+    """
+
+    def __init__(self, key: str, problem: str) -> None:
+        super().__init__(f"{key} {problem}")
+        self.key = key
+        self.problem = problem
+
+
+def blame(error: SettingError, path: str | os.PathLike, options: Mapping[str, str]) -> ConfigError:
+    """``error`` in one line naming where the setting came from.
+
+    Args:
+        path: the settings file the run read.
+        options: setting key -> the command-line option that set it (only those given).
+
+    """
+    option = options.get(error.key)
+    if option:
+        return ConfigError(f"{option}: {error.problem}")
+    return ConfigError(f"{path}: {error.key} {error.problem}")
+
+
+def settings_path(path: str | os.PathLike | None, robot: str | None) -> Path:
+    """The settings file a run reads: ``path``, or the shipped file of ``robot``'s family."""
+    return Path(path) if path is not None else default_settings_file(robot or "4ws-5")
+
+
+def load_settings(
+    path: str | os.PathLike | None = None,
+    options: Mapping[str, str] | None = None,
+    **overrides,
+) -> MapElitesSettings:
     """Settings from a YAML file with ``overrides`` (``None`` values are ignored) on top.
 
     Without ``path`` the shipped file of the robot family is used; the robot comes from
     ``overrides`` or the file.
 
+    Args:
+        options: setting key -> command-line option, so that a bad override is blamed on
+            its option (``--bin-size: must be >= 0.0001, got 1e-09``), not on the file.
+
     Raises:
-        evorbc_ros.config.ConfigError: naming the file and the offending key.
+        evorbc_ros.config.ConfigError: naming the file and the offending key, or the option.
 
     """
     overrides = {k: v for k, v in overrides.items() if v is not None}
-    if path is None:
-        path = default_settings_file(overrides.get("robot", "4ws-5"))
+    options = options or {}
+    for key, value in overrides.items():
+        _check_override(key, value, options.get(key, f"override {key}"))
+    path = settings_path(path, overrides.get("robot"))
     values = load_yaml_mapping(path)
     values.update(overrides)
     return build_settings(MapElitesSettings, values, str(path))
+
+
+def _check_override(key: str, value, label: str) -> None:
+    """Check one override alone, so that its error names ``label`` rather than the file."""
+    fields = {f.name: f for f in dataclasses.fields(MapElitesSettings)}
+    if key not in fields:
+        raise ConfigError(f"{label}: unknown setting {key!r}")
+    hint = typing.get_type_hints(MapElitesSettings)[key]
+    single = dataclasses.make_dataclass(
+        "Override", [(key, hint, dataclasses.field(metadata=fields[key].metadata))]
+    )
+    try:
+        build_settings(single, {key: value}, label)
+    except ConfigError as e:
+        # build_settings says "<label>: <key> must be ..."; the option alone is clearer.
+        raise ConfigError(str(e).replace(f"{label}: {key} ", f"{label}: ", 1)) from None
