@@ -164,3 +164,41 @@ def test_replay_over_many_random_starts_reports_each_maze(evolved, capsys):
     assert code == 0 and "random starts per maze" in stdout and "mean time reached" in stdout
     code, _, err = run(capsys, "replay", "--arbitrator", out, "--episodes", 3)
     assert code == 1 and "--start random" in err and len(err.splitlines()) == 1
+
+
+def test_a_failed_write_keeps_the_finished_run_and_the_same_command_writes_it(
+    tmp_path, capsys, monkeypatch, small_repertoire, small_neat_file, small_task_file
+):
+    import offline_evolution.plots.fitness as fitness
+
+    rep = tmp_path / "r.json"
+    small_repertoire.save(rep)
+
+    def disk_full(history, path, **_):  # the disk fills up as the curve is written
+        raise OSError(28, "No space left on device", str(path))
+
+    monkeypatch.setattr(fitness, "plot_fitness_history", disk_full)
+    argv = ["arbitrator", "--repertoire", rep, "--generations", 2, "--neat-config",
+            small_neat_file, "--task", small_task_file, "--out", tmp_path / "a.json"]  # fmt: skip
+    code, _, err = run(capsys, *argv)
+    checkpoint = tmp_path / "a.json.checkpoint.json"
+    last = err.strip().splitlines()[-1]  # after the progress lines, one line of error
+    assert code == 1 and last.startswith("evorbc-evolve: error: ") and "No space left" in last
+    assert f"the finished run is kept in {checkpoint}" in last and checkpoint.exists()
+    monkeypatch.undo()
+    code, _, err = run(capsys, *argv)
+    assert code == 0 and "generation " not in err  # nothing evolved again: files written
+    assert ArbitratorFile.load(tmp_path / "a.json").evolution["generations"] == 2
+    assert not checkpoint.exists()
+
+
+def test_restart_deletes_only_a_neat_checkpoint(tmp_path, capsys, small_repertoire):
+    rep = tmp_path / "r.json"
+    small_repertoire.save(rep)
+    precious = tmp_path / "precious.json"
+    precious.write_text('{"format": "evorbc-repertoire"}')
+    code, _, err = run(capsys, "arbitrator", "--repertoire", rep, "--out", tmp_path / "a.json",
+                       "--checkpoint", precious, "--restart")  # fmt: skip
+    assert code == 1 and "--restart does not delete it" in err and precious.exists()
+    code, _, err = run(capsys, "arbitrator", "--repertoire", rep, "--out", rep)
+    assert code == 1 and "is the same file as --out" in err and rep.exists()

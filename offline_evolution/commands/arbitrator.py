@@ -13,9 +13,12 @@ from offline_evolution.commands.common import (
     CliError,
     StopOnSignal,
     add_workers_option,
+    check_distinct,
     check_writable,
     count,
     default_checkpoint,
+    restart_from_scratch,
+    write_then_discard,
 )
 
 
@@ -113,6 +116,7 @@ class _GenerationPrinter:
 def cmd_evolve(args: argparse.Namespace) -> int:
     """Evolve an arbitrator or a standard-NEAT controller and write its file and curve."""
     from offline_evolution.arbitrator.evolve import (
+        CHECKPOINT_KIND,
         EQUAL_BUDGET_GENERATIONS,
         EvolutionSettings,
         arbitrator_file,
@@ -154,8 +158,19 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     out = Path(args.out)
     plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")
     checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.json")
-    if args.restart and checkpoint.exists():
-        checkpoint.unlink()
+    check_distinct(
+        {
+            "--out": out,
+            "--plot": plot,
+            "--checkpoint": checkpoint,
+            "--repertoire": args.repertoire if repertoire else None,
+            "--config": args.config,
+            "--neat-config": args.neat_config,
+            "--task": args.task,
+        }
+    )
+    if args.restart:
+        restart_from_scratch(checkpoint, CHECKPOINT_KIND, "NEAT evolution checkpoint")
     check_writable(out, plot)
     every = args.checkpoint_every or run.checkpoint_every
     stop = StopOnSignal("generation")
@@ -170,9 +185,12 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             should_stop=stop,
             workers=args.workers or None,
             repertoire_source=args.repertoire if repertoire else "the repertoire",
+            keep_checkpoint=True,  # deleted only once the files below are written
         )
     except CheckpointError as e:
-        raise CliError(f"{e}; use --restart to discard it") from None
+        if e.discardable:
+            raise CliError(f"{e}; use --restart to discard it") from None
+        raise CliError(f"{e}; choose another --checkpoint") from None
     except Interrupted as e:
         raise CliError(
             f"interrupted after generation {e.iteration}; finished work is saved "
@@ -181,19 +199,24 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         ) from None
     finally:
         stop.restore(previous)
-    task = make_task(task_settings, robot, workers=1)
-    try:
-        arbitrator_file(result, task, repertoire, args.repertoire if repertoire else None).save(out)
-    finally:
-        task.close()
-    from offline_evolution.plots.fitness import plot_fitness_history
 
-    plot_fitness_history(
-        result.history,
-        plot,
-        title=f"{'EvoRBC' if args.kind == 'evorbc' else 'standard NEAT'}, "
-        f"{robot}, seed {args.seed}",
-    )
+    def write() -> None:
+        task = make_task(task_settings, robot, workers=1)
+        try:
+            arb = arbitrator_file(result, task, repertoire, args.repertoire if repertoire else None)
+            arb.save(out)
+        finally:
+            task.close()
+        from offline_evolution.plots.fitness import plot_fitness_history
+
+        plot_fitness_history(
+            result.history,
+            plot,
+            title=f"{'EvoRBC' if args.kind == 'evorbc' else 'standard NEAT'}, "
+            f"{robot}, seed {args.seed}",
+        )
+
+    write_then_discard(checkpoint, write)
     label = "arbitrator" if args.kind == "evorbc" else "standard-NEAT controller"
     post = result.post_evaluation
     print(

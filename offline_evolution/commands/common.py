@@ -148,3 +148,19 @@ def write_then_discard(checkpoint: Path, write: Callable[[], None]) -> None:
             "again to write its files"
         ) from None
     checkpoint.unlink(missing_ok=True)
+
+
+def restart_from_scratch(checkpoint: Path, kind: str, what: str) -> None:
+    """``--restart``: delete ``checkpoint`` if it is a checkpoint of ``kind``, else refuse.
+
+    A file given as ``--checkpoint`` by mistake (a repertoire, say) is never deleted.
+    """
+    from offline_evolution.checkpoint import CheckpointError, discard_checkpoint
+
+    try:
+        discard_checkpoint(checkpoint, kind, what)
+    except CheckpointError as e:
+        raise CliError(
+            f"{e}, so --restart does not delete it; remove it yourself or choose "
+            "another --checkpoint"
+        ) from None

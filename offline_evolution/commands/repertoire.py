@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.checkpoint import CheckpointError, Interrupted, discard_checkpoint
+from offline_evolution.checkpoint import CheckpointError, Interrupted
 from offline_evolution.commands.common import (
     EXIT_INTERRUPTED,
     CliError,
@@ -19,6 +19,7 @@ from offline_evolution.commands.common import (
     count,
     default_checkpoint,
     positive_float,
+    restart_from_scratch,
     write_then_discard,
 )
 
@@ -168,13 +169,7 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
     settings = load_settings(config, options=given, **{k: getattr(args, k) for k in OPTIONS})
     check_writable(out, args.plot, args.csv)
     if args.restart:
-        try:
-            discard_checkpoint(checkpoint, CHECKPOINT_KIND, "MAP-Elites checkpoint")
-        except CheckpointError as e:
-            raise CliError(
-                f"{e}, so --restart does not delete it; remove it yourself or choose "
-                "another --checkpoint"
-            ) from None
+        restart_from_scratch(checkpoint, CHECKPOINT_KIND, "MAP-Elites checkpoint")
     stop = StopOnSignal("batch")
     previous_handlers = stop.install()
     start = time.perf_counter()
