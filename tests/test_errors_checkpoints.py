@@ -345,3 +345,22 @@ def test_a_setting_that_does_not_suit_the_robot_names_the_file_and_key(
     cfg.write_text("".join(f"{k}: {v}\n" for k, v in base.items()))
     err = one_line_error(capsys, "repertoire", "--config", cfg, "--out", tmp_path / "r.json")
     assert err.startswith(f"evorbc-evolve: error: {cfg}: {message}")
+
+
+def test_a_run_that_keeps_no_primitive_writes_nothing_and_says_so(tmp_path, capsys, monkeypatch):
+    import offline_evolution.repertoire.map_elites as map_elites
+
+    real = map_elites.generate_repertoire
+
+    def nothing_kept(*args, **kwargs):  # as if every primitive left the archive's range
+        rep = real(*args, **kwargs)
+        keep = np.zeros(len(rep), dtype=bool)
+        return Repertoire(rep.robot, rep.parameters, rep.genes[keep], rep.behaviour[keep],
+                          rep.heading[keep], rep.quality[keep], rep.metric, rep.eval_time,
+                          rep.bin_size, rep.seed, rep.archive, rep.algorithm)  # fmt: skip
+
+    monkeypatch.setattr(map_elites, "generate_repertoire", nothing_kept)
+    out = tmp_path / "r.json"
+    code, _, err = run_cli(capsys, "repertoire", *TINY, "--out", out)
+    assert code == 1 and err.startswith("evorbc-evolve: error: no primitive was kept after")
+    assert not out.exists() and not (tmp_path / "r.json.checkpoint.npz").exists()

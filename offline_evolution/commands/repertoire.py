@@ -198,6 +198,14 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
     finally:
         stop.restore(previous_handlers)
     elapsed = time.perf_counter() - start
+    if len(repertoire) == 0:
+        # A repertoire without primitives could drive nothing (and would not load).
+        checkpoint.unlink(missing_ok=True)
+        raise CliError(
+            f"no primitive was kept after {repertoire.algorithm['evaluations']:,} evaluations "
+            "(each one left the archive's range or was discarded); nothing written to "
+            f"{out}; try a larger budget or another --metric"
+        )
     write_then_discard(checkpoint, lambda: _write(repertoire, out, args.plot, args.csv))
     s = repertoire.summary()
     print(
