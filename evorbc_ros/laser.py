@@ -66,13 +66,23 @@ class LaserToRangefinders:
         They read 0 ("nothing seen") from such a scanner; the arbitrator was evolved with
         them, so the node warns rather than refusing every scan.
         """
-        beam = angle_min + angle_increment * np.arange(n_beams)
-        heading = beam + self.pose.yaw
+        heading = angle_min + angle_increment * np.arange(n_beams) + self.pose.yaw
+        # Directions of points 1 m along each beam, as ``readings`` takes for no return.
         direction = np.arctan2(self.pose.y + np.sin(heading), self.pose.x + np.cos(heading))
-        offset = np.abs(_wrap(direction[None, :] - self.axes[:, None]))
-        reach = max(0.5 * self.layout.field_of_view, 0.5 * abs(angle_increment))
-        missed = ~(offset <= reach + ANGLE_TOLERANCE).any(axis=1)
+        missed = ~(self._offsets(direction) <= self._reach(angle_increment)).any(axis=1)
         return [round(math.degrees(a), 1) for a in self.axes[missed]]
+
+    def _offsets(self, direction: np.ndarray) -> np.ndarray:
+        """(n_axes, n_beams) angle (rad) of each beam direction from each rangefinder axis."""
+        return np.abs(_wrap(direction[None, :] - self.axes[:, None]))
+
+    def _reach(self, angle_increment: float) -> float:
+        """Largest offset (rad) at which a beam counts for a rangefinder.
+
+        Half its field of view, or for a one-ray rangefinder half the beam spacing.
+        """
+        half_fov = 0.5 * self.layout.field_of_view
+        return (half_fov if half_fov > 0.0 else 0.5 * abs(angle_increment)) + ANGLE_TOLERANCE
 
     def readings(
         self, angle_min: float, angle_increment: float, ranges, range_min: float, range_max: float
@@ -117,12 +127,10 @@ class LaserToRangefinders:
         from_centre = np.where(finite, np.hypot(hx, hy), np.inf)
         from_mount = np.maximum(from_centre - self.layout.mount_radius, 0.0)
 
-        # (n_axes, n_beams) angle of each beam from each rangefinder's axis.
-        offset = np.abs(_wrap(direction[None, :] - self.axes[:, None]))
-        half_fov = 0.5 * self.layout.field_of_view
-        half_gap = 0.5 * abs(angle_increment) + ANGLE_TOLERANCE
-        if half_fov > 0.0:
-            inside = offset <= half_fov + ANGLE_TOLERANCE
+        offset = self._offsets(direction)
+        reach = self._reach(angle_increment)
+        if self.layout.field_of_view > 0.0:
+            inside = offset <= reach
             members = valid[None, :] & inside
             in_span, usable = inside.any(axis=1), members.any(axis=1)
             nearest = np.where(members, from_mount[None, :], np.inf).min(axis=1)
@@ -130,8 +138,8 @@ class LaserToRangefinders:
             # One ray: the beam nearest the axis (first of equals), if within half a gap.
             candidates = np.where(valid[None, :], offset, np.inf)
             j = np.argmin(candidates, axis=1)
-            usable = candidates[np.arange(len(j)), j] <= half_gap
-            in_span = offset.min(axis=1) <= half_gap
+            usable = candidates[np.arange(len(j)), j] <= reach
+            in_span = offset.min(axis=1) <= reach
             nearest = np.where(usable, from_mount[j], np.inf)
         blind = in_span & ~usable
         if blind.any():
