@@ -151,3 +151,50 @@ def test_hall_of_fame_keeps_the_top_and_the_recent_champions():
     assert [g["key"] for g in hall.recent] == [2, 2, 6]  # an elite can win twice
     assert [g["key"] for g in hall.candidates()] == [2, 1, 5, 6]
     assert HallOfFame.from_dict(hall.to_dict()).candidates() == hall.candidates()
+
+
+def test_post_evaluation_settings_may_change_on_resume(tmp_path, small_neat_file, small_repertoire):
+    # They act only after the last generation, so a wider post-evaluation or another rule
+    # must not throw away finished generations.
+    ckpt = tmp_path / "c.json"
+    s = settings(small_neat_file, generations=4, repertoire=small_repertoire)
+    with pytest.raises(Interrupted):
+        evolve(s, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    wider = EvolutionSettings(**{**s.as_dict(), "post_samples": 3, "post_rule": "nominal_then_mean"})
+    result = evolve(wider, small_repertoire, checkpoint=ckpt)
+    assert result.post_evaluation.rule == "nominal_then_mean"
+    assert result.post_evaluation.episodes == 2 * (1 + 3)  # two mazes
+
+
+class _ScoredTask:
+    """Stands in for MazeTask.evaluate with fixed per-episode outcomes (rule logic only)."""
+
+    def __init__(self, fitness, reached):
+        self.mazes = ("a",)
+        self.fitness, self.reached = np.asarray(fitness, float), np.asarray(reached, bool)
+
+    def evaluate(self, networks, controller, starts):
+        from types import SimpleNamespace
+
+        return SimpleNamespace(fitness=self.fitness.ravel(), reached=self.reached.ravel())
+
+
+@pytest.mark.parametrize(
+    ("reached", "rule", "chosen", "from_nominal"),
+    [
+        # columns: the nominal start, then two random starts; rows: candidates
+        ([[0, 1, 1], [1, 0, 0], [1, 1, 0]], "mean", 0, False),
+        ([[0, 1, 1], [1, 0, 0], [1, 1, 0]], "nominal_then_mean", 2, True),
+        ([[0, 1, 1], [0, 0, 0], [0, 1, 0]], "nominal_then_mean", 0, False),  # none: by mean
+    ],
+)
+def test_post_evaluation_rules(reached, rule, chosen, from_nominal):
+    from offline_evolution.arbitrator.selection import post_evaluate
+
+    fitness = [[0.9, 1.2, 1.2], [1.1, 0.5, 0.5], [1.1, 1.1, 0.6]]  # means 1.1, 0.7, 0.93
+    post = post_evaluate(_ScoredTask(fitness, reached), None, [0, 1, 2], np.zeros((3, 4)), rule)
+    assert (post.index, post.reached_nominal) == (chosen, from_nominal)
+    assert post.fitness == pytest.approx(np.mean(fitness[chosen]))
+    assert post.nominal_reachers == sum(row[0] for row in reached)
+    with pytest.raises(ValueError, match="rule must be one of"):
+        post_evaluate(_ScoredTask(fitness, reached), None, [0, 1, 2], np.zeros((3, 4)), "best")

@@ -59,6 +59,10 @@ CHECKPOINT_KIND = "evorbc-neat-checkpoint"
 EQUAL_BUDGET_GENERATIONS = {"4ws": 25, "hexapod": 455}
 
 
+#: EvolutionSettings fields used only by the final post-evaluation (may change on resume).
+POST_ONLY = ("post_samples", "post_rule")
+
+
 @dataclass(frozen=True)
 class EvolutionSettings:
     """Everything that determines an evolution run's result."""
@@ -74,6 +78,7 @@ class EvolutionSettings:
     repertoire_fingerprint: str | None = None
     hall_of_fame: int = 25  # genomes kept for the final post-evaluation
     post_samples: int = 10  # random starts per maze in the post-evaluation
+    post_rule: str = "mean"  # how the post-evaluation picks the written genome (selection.RULES)
 
     def as_dict(self) -> dict:
         """Plain-data form (checkpoints and arbitrator files)."""
@@ -237,7 +242,11 @@ class Evolution:
         candidates = self.hall.candidates()
         starts = post_evaluation_starts(self.task, self.settings.seed, self.settings.post_samples)
         post = post_evaluate(
-            self.task, self.controller, [self.network(g) for g in candidates], starts
+            self.task,
+            self.controller,
+            [self.network(g) for g in candidates],
+            starts,
+            self.settings.post_rule,
         )
         chosen = candidates[post.index]
         return EvolutionResult(
@@ -283,7 +292,13 @@ class Evolution:
             raise CheckpointError(f"{path}: not a NEAT evolution checkpoint", discardable=False)
         if not isinstance(data.get("settings"), dict):
             raise CheckpointError(f"{path}: not a usable checkpoint (settings missing)")
-        mismatch = settings_mismatch(data["settings"], self.settings.as_dict())
+        # The post-evaluation runs after the last generation, so its settings may change
+        # between sessions without touching finished work.
+        saved, now = (
+            {k: v for k, v in d.items() if k not in POST_ONLY}
+            for d in (data["settings"], self.settings.as_dict())
+        )
+        mismatch = settings_mismatch(saved, now)
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
         check_same_robot(path, data.get("simulation"), self.simulation)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
 from evorbc_ros.mapping import MAPPINGS
+from offline_evolution.arbitrator.selection import RULES
 
 
 @dataclass(frozen=True)
@@ -21,6 +22,9 @@ class ArbitratorRunSettings:
     checkpoint_every: int = setting(10, doc="generations between checkpoints", minimum=1)
     hall_of_fame: int = setting(25, doc="genomes kept for the post-evaluation", minimum=1)
     post_samples: int = setting(10, doc="random starts per maze in the post-evaluation", minimum=0)
+    post_rule: str = setting(
+        "mean", doc="how the post-evaluation picks the controller to write", choices=RULES
+    )
 
     def neat_path(self) -> Path:
         """The NEAT settings file."""

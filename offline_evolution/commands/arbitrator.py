@@ -154,6 +154,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
         hall_of_fame=run.hall_of_fame,
         post_samples=run.post_samples,
+        post_rule=run.post_rule,
     )
     out = Path(args.out)
     plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")

@@ -75,6 +75,7 @@ def run_one(robot: str, kind: str, seed: int, generations: int, runs: Path) -> d
         repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
         hall_of_fame=run.hall_of_fame,
         post_samples=run.post_samples,
+        post_rule=run.post_rule,
     )
     start = time.perf_counter()
     result = evolve(
