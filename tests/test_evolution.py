@@ -160,7 +160,9 @@ def test_post_evaluation_settings_may_change_on_resume(tmp_path, small_neat_file
     s = settings(small_neat_file, generations=4, repertoire=small_repertoire)
     with pytest.raises(Interrupted):
         evolve(s, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
-    wider = EvolutionSettings(**{**s.as_dict(), "post_samples": 3, "post_rule": "nominal_then_mean"})
+    wider = EvolutionSettings(
+        **{**s.as_dict(), "post_samples": 3, "post_rule": "nominal_then_mean"}
+    )
     result = evolve(wider, small_repertoire, checkpoint=ckpt)
     assert result.post_evaluation.rule == "nominal_then_mean"
     assert result.post_evaluation.episodes == 2 * (1 + 3)  # two mazes

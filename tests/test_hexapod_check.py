@@ -14,7 +14,7 @@ TASK = {"mazes": ["hexapod"], "episode_time": 2.0, "samples_per_maze": 1,
         "sensors": "sensors/hexapod.yaml"}  # fmt: skip
 
 
-def evolution(seed, best, first_reach, post_fitness, post_reached):
+def evolution(seed, best, first_reach, post_fitness, post_reached, rule=None):
     """An ``evolution`` record as the CLI writes it, 10 generations long."""
     history = [
         {"generation": g, "best_reached": int(first_reach is not None and g >= first_reach)}
@@ -24,7 +24,7 @@ def evolution(seed, best, first_reach, post_fitness, post_reached):
         "seed": seed, "generations": 10, "best_fitness": best, "history": history,
         "best_reached": int(first_reach is not None), "task": TASK,
         "post_evaluation": {"fitness": post_fitness, "reached": post_reached,
-                            "episodes_per_candidate": 21},
+                            "episodes_per_candidate": 21, **({"rule": rule} if rule else {})},
     }  # fmt: skip
 
 
@@ -35,7 +35,8 @@ def runs(tmp_path_factory):
     rep.save(out / "rep.json")
     layout = SensorLayout.load(config_dir() / "sensors" / "hexapod.yaml")
     config = neat_config(6, 2, path="config/neat/hexapod.ini")
-    for seed, best, first, post in ((1, 1.2, 6, (0.9, 0.5)), (2, 1.3, None, (0.7, 0.1))):
+    runs = ((1, 1.2, 6, (0.9, 0.5, None)), (2, 1.3, None, (0.7, 0.1, "nominal_then_mean")))
+    for seed, best, first, post in runs:
         ArbitratorFile(
             kind="evorbc", robot="hexapod", sensors=layout, mapping="polar",
             network=network_spec(random_genomes(config, 1, seed=seed)[0], config),
@@ -60,7 +61,9 @@ def test_summary_reports_the_runs_next_to_the_paper(runs):
     evo = rows["| EvoRBC best fitness, 2 run(s) of 10 generations"]
     assert "1.25 ± 0.07; goal reached in 1 of 2; first reached at generation 7, never" in evo
     post = next(v for k, v in rows.items() if k.startswith("| selected EvoRBC"))
-    assert "seed 1: 0.90, reached 50 % of 21; seed 2: 0.70, reached 10 % of 21" in post
+    # a random network 2 s into the maze does not reach; the rule is recorded per seed
+    assert "seed 1 (rule mean): 0.90, reached 50 % of 21, misses from the nominal start" in post
+    assert "seed 2 (rule nominal_then_mean): 0.70, reached 10 % of 21, misses" in post
     assert any(k.startswith("| primitive switches") for k in rows)
     std = rows["| standard NEAT, 1 run(s) of 10 generations"]
     assert "best fitness 0.40, goal reached in 0 of 1" in std and "% of the way" in std
