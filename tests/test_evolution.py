@@ -200,3 +200,57 @@ def test_post_evaluation_rules(reached, rule, chosen, from_nominal):
     assert post.nominal_reachers == sum(row[0] for row in reached)
     with pytest.raises(ValueError, match="rule must be one of"):
         post_evaluate(_ScoredTask(fitness, reached), None, [0, 1, 2], np.zeros((3, 4)), "best")
+
+
+def test_nominal_watch_keeps_genomes_that_reach_and_leaves_the_evolution_alone(
+    tmp_path, small_neat_file
+):
+    import yaml
+    from test_maze_task import CORRIDOR
+
+    from offline_evolution.arbitrator.evolve import Evolution
+
+    # A corridor whose target is 2 m straight ahead of the nominal start (heading 0).
+    maze = tmp_path / "corridor.yaml"
+    maze.write_text(yaml.safe_dump(CORRIDOR))
+    task = {"mazes": [str(maze)], "episode_time": 20.0, "samples_per_maze": 1,
+            "sensors": "sensors/4ws.yaml"}  # fmt: skip
+    base = {**settings(small_neat_file, kind="standard", generations=3).as_dict(), "task": task}
+    plain = evolve(EvolutionSettings(**base), None)
+    watched = EvolutionSettings(**{**base, "nominal_watch": 5, "post_rule": "nominal_then_mean"})
+    same(plain, evolve(watched, None))  # the watch draws no random numbers
+    run = Evolution(watched)
+    try:
+        run.step()
+        config = run.config
+        # Full speed (sigmoid(5 x 10) = 1), wheels straight (sigmoid(0) = 0.5 is gene 0):
+        # it crosses the corridor (tests/test_maze_task.py). A zero-speed one does not.
+        fast, still = (config.genome_type(k) for k in (10_001, 10_002))
+        for genome, speed_bias in ((fast, 10.0), (still, -10.0)):
+            genome.configure_new(config.genome_config)
+            genome.connections.clear()
+            for key, node in genome.nodes.items():
+                node.bias, node.response = (speed_bias if key == 0 else 0.0), 1.0
+                node.activation, node.aggregation = "sigmoid", "sum"
+            genome.fitness = 0.0  # a training fitness that keeps it out of the top
+        run._watch_nominal([fast, still], config)
+        assert [g["key"] for g in run.hall.nominal] == [10_001]
+        assert run.hall.nominal[0]["nominal_fitness"] == pytest.approx(2.0 - 9.5 / 20.0)
+        result = run.result(0.0)  # the rule finds it among the mere top and recent
+        assert result.post_evaluation.reached_nominal
+        assert result.post_evaluation.nominal_reachers >= 1
+    finally:
+        run.task.close()
+
+
+def test_hall_of_fame_keeps_the_best_nominal_reachers():
+    from offline_evolution.arbitrator.selection import HallOfFame
+
+    hall = HallOfFame(2)
+    for key, f in [(1, 1.5), (2, 1.7), (1, 1.5), (3, 1.6)]:
+        hall.add_nominal({"key": key, "fitness": 0.3, "nominal_fitness": f})
+    assert [g["key"] for g in hall.nominal] == [2, 3]
+    assert [g["key"] for g in hall.candidates()] == [2, 3]
+    assert HallOfFame.from_dict(hall.to_dict()).nominal == hall.nominal
+    old = {"size": 2, "top": [], "recent": []}  # a checkpoint from before the watch
+    assert HallOfFame.from_dict(old).nominal == []

@@ -59,8 +59,9 @@ CHECKPOINT_KIND = "evorbc-neat-checkpoint"
 EQUAL_BUDGET_GENERATIONS = {"4ws": 25, "hexapod": 455}
 
 
-#: EvolutionSettings fields used only by the final post-evaluation (may change on resume).
-POST_ONLY = ("post_samples", "post_rule")
+#: EvolutionSettings fields that only decide which genome is written, never how the
+#: population evolves, so they may change when a run resumes from a checkpoint.
+SELECTION_ONLY = ("post_samples", "post_rule", "nominal_watch")
 
 
 @dataclass(frozen=True)
@@ -79,6 +80,9 @@ class EvolutionSettings:
     hall_of_fame: int = 25  # genomes kept for the final post-evaluation
     post_samples: int = 10  # random starts per maze in the post-evaluation
     post_rule: str = "mean"  # how the post-evaluation picks the written genome (selection.RULES)
+    # Each generation's best this many genomes are also run from every maze's nominal
+    # start; those that reach the target there join the hall of fame (0: none).
+    nominal_watch: int = 0
 
     def as_dict(self) -> dict:
         """Plain-data form (checkpoints and arbitrator files)."""
@@ -179,6 +183,7 @@ class Evolution:
         self.best_generation = -1
         self.best_reached = 0  # mazes the best genome reached in its evaluation
         self.hall = HallOfFame(settings.hall_of_fame)
+        self._watched: set[int] = set()  # genome keys already run from the nominal starts
 
     @property
     def generation(self) -> int:
@@ -205,6 +210,7 @@ class Evolution:
         # Only the top of a generation can enter the hall: convert just those to dicts.
         ranked = sorted((g for _, g in genomes), key=lambda g: (-g.fitness, g.key))
         self.hall.update([genome_to_dict(g) for g in ranked[: self.hall.size]])
+        self._watch_nominal(ranked[: self.settings.nominal_watch], config)
         self._eval_seconds = time.perf_counter() - start
         k = int(np.argmax(fitness))
         if self.best is None or fitness[k] > self.best["fitness"]:
@@ -212,6 +218,28 @@ class Evolution:
             self.best_generation = generation
             self.best_reached = int(reached[k])
         self._gen_figures = (float(fitness[k]), float(fitness.mean()), int(reached[k]))
+
+    def _watch_nominal(self, genomes: list, config) -> None:
+        """Run genomes not seen before from every nominal start; keep those that reach.
+
+        Training sees one random start per generation, so a genome that walks the whole
+        maze from the nominal start can drop out of the top by training fitness before
+        the post-evaluation; this keeps it. The starts draw no random numbers, so the
+        evolution is the same with or without the watch.
+        """
+        fresh = [g for g in genomes if g.key not in self._watched]
+        if not fresh:
+            return
+        self._watched.update(g.key for g in fresh)
+        starts = self.task.nominal_starts()
+        result = self.task.evaluate(
+            [network_spec(g, config) for g in fresh], self.controller, starts
+        )
+        fitness = result.fitness.reshape(len(fresh), len(starts)).mean(axis=1)
+        reached = result.reached.reshape(len(fresh), len(starts)).all(axis=1)
+        for g, f, ok in zip(fresh, fitness, reached, strict=True):
+            if ok:
+                self.hall.add_nominal({**genome_to_dict(g), "nominal_fitness": float(f)})
 
     def step(self) -> GenerationStats:
         """Evaluate the current generation and breed the next one."""
@@ -292,10 +320,10 @@ class Evolution:
             raise CheckpointError(f"{path}: not a NEAT evolution checkpoint", discardable=False)
         if not isinstance(data.get("settings"), dict):
             raise CheckpointError(f"{path}: not a usable checkpoint (settings missing)")
-        # The post-evaluation runs after the last generation, so its settings may change
-        # between sessions without touching finished work.
+        # Selection settings never change the population, so they may change between
+        # sessions without touching finished work.
         saved, now = (
-            {k: v for k, v in d.items() if k not in POST_ONLY}
+            {k: v for k, v in d.items() if k not in SELECTION_ONLY}
             for d in (data["settings"], self.settings.as_dict())
         )
         mismatch = settings_mismatch(saved, now)
@@ -325,10 +353,14 @@ class Evolution:
         self.best_generation = require(data, "best_generation", int)
         self.best_reached = require(data, "best_reached", int)
         hall = require(data, "hall_of_fame", dict)
-        for part in ("top", "recent"):
+        for part in ("top", "recent", "nominal"):
+            if part == "nominal" and part not in hall:
+                continue  # written before the nominal watch existed
             for i, g in enumerate(require(hall, part, list, "hall_of_fame.")):
                 genome_from_dict(g, self.config, f"hall_of_fame.{part}[{i}].")
                 require(g, "fitness", float, f"hall_of_fame.{part}[{i}].")
+                if part == "nominal":
+                    require(g, "nominal_fitness", float, f"hall_of_fame.{part}[{i}].")
         self.hall = HallOfFame.from_dict(hall)
         history = require(data, "history", list)
         if len(history) != generation:

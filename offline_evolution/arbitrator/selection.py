@@ -29,16 +29,20 @@ RULES = ("mean", "nominal_then_mean")
 
 
 class HallOfFame:
-    """The top genomes by training fitness plus the latest generations' champions.
+    """Genomes kept for the post-evaluation.
 
-    Genomes are kept as plain dicts (``neat_state.genome_to_dict``) so the hall goes into
-    JSON checkpoints as it is.
+    They are the top genomes by training fitness, the latest generations' champions, and
+    the genomes seen to reach the target from every maze's nominal start. Genomes are
+    kept as plain dicts (``neat_state.genome_to_dict``) so the hall goes into JSON
+    checkpoints as it is.
     """
 
     def __init__(self, size: int) -> None:
         self.size = size
         self.top: list[dict] = []  # highest training fitness first, unique genome keys
         self.recent: list[dict] = []  # champions of the last ``size`` generations
+        # Reached the target from every nominal start; highest "nominal_fitness" first.
+        self.nominal: list[dict] = []
 
     def update(self, genomes: list[dict]) -> None:
         """Offer one generation's genomes (dicts with their training fitness)."""
@@ -52,10 +56,21 @@ class HallOfFame:
                 keys.add(g["key"])
         self.top = sorted(self.top, key=lambda g: (-g["fitness"], g["key"]))[: self.size]
 
+    def add_nominal(self, genome: dict) -> None:
+        """Keep a genome that reached the target from every nominal start.
+
+        ``genome`` carries its training ``fitness`` and its mean ``nominal_fitness`` over
+        those starts; the ``size`` best by the latter are kept.
+        """
+        if any(g["key"] == genome["key"] for g in self.nominal):
+            return
+        ranked = sorted([*self.nominal, genome], key=lambda g: (-g["nominal_fitness"], g["key"]))
+        self.nominal = ranked[: self.size]
+
     def candidates(self) -> list[dict]:
         """Every genome in the hall once (top first)."""
         seen, out = set(), []
-        for g in [*self.top, *self.recent]:
+        for g in [*self.top, *self.recent, *self.nominal]:
             if g["key"] not in seen:
                 seen.add(g["key"])
                 out.append(g)
@@ -63,14 +78,15 @@ class HallOfFame:
 
     def to_dict(self) -> dict:
         """Plain-data form for checkpoints."""
-        return {"size": self.size, "top": self.top, "recent": self.recent}
+        return {"size": self.size, "top": self.top, "recent": self.recent, "nominal": self.nominal}
 
     @classmethod
     def from_dict(cls, data: dict) -> HallOfFame:
-        """Rebuild from :meth:`to_dict`."""
+        """Rebuild from :meth:`to_dict` (checkpoints before the nominal list have none)."""
         hall = cls(int(data["size"]))
         hall.top = list(data["top"])
         hall.recent = list(data["recent"])
+        hall.nominal = list(data.get("nominal", []))
         return hall
 
 

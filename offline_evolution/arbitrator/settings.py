@@ -25,6 +25,12 @@ class ArbitratorRunSettings:
     post_rule: str = setting(
         "mean", doc="how the post-evaluation picks the controller to write", choices=RULES
     )
+    nominal_watch: int = setting(
+        0,
+        doc="each generation's best genomes also run from every nominal start; "
+        "those that reach join the hall of fame",
+        minimum=0,
+    )
 
     def neat_path(self) -> Path:
         """The NEAT settings file."""

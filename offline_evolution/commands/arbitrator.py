@@ -155,6 +155,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         hall_of_fame=run.hall_of_fame,
         post_samples=run.post_samples,
         post_rule=run.post_rule,
+        nominal_watch=run.nominal_watch,
     )
     out = Path(args.out)
     plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")

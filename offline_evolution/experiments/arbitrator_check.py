@@ -76,6 +76,7 @@ def run_one(robot: str, kind: str, seed: int, generations: int, runs: Path) -> d
         hall_of_fame=run.hall_of_fame,
         post_samples=run.post_samples,
         post_rule=run.post_rule,
+        nominal_watch=run.nominal_watch,
     )
     start = time.perf_counter()
     result = evolve(
