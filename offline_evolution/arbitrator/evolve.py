@@ -455,6 +455,8 @@ def arbitrator_file(
             **result.post_evaluation.as_dict(),
             "samples_per_maze": s.post_samples,
             "nominal_starts": True,
+            "hall_of_fame": s.hall_of_fame,
+            "nominal_watch": s.nominal_watch,
         },
         "seconds": round(result.seconds, 1),
         "neat_settings": Path(s.neat_file).name,
