@@ -32,6 +32,15 @@ class ArbitratorRunSettings:
         minimum=0,
     )
 
+    def selection(self) -> dict:
+        """The keys that choose the genome written (``EvolutionSettings`` fields)."""
+        return {
+            "hall_of_fame": self.hall_of_fame,
+            "post_samples": self.post_samples,
+            "post_rule": self.post_rule,
+            "nominal_watch": self.nominal_watch,
+        }
+
     def neat_path(self) -> Path:
         """The NEAT settings file."""
         return _resolve(self.neat)

@@ -152,10 +152,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         task=task_settings.as_dict(),
         mapping=(args.mapping or run.mapping) if args.kind == "evorbc" else None,
         repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
-        hall_of_fame=run.hall_of_fame,
-        post_samples=run.post_samples,
-        post_rule=run.post_rule,
-        nominal_watch=run.nominal_watch,
+        **run.selection(),
     )
     out = Path(args.out)
     plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")

@@ -73,10 +73,7 @@ def run_one(robot: str, kind: str, seed: int, generations: int, runs: Path) -> d
         task=task_settings.as_dict(),
         mapping=run.mapping if kind == "evorbc" else None,
         repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
-        hall_of_fame=run.hall_of_fame,
-        post_samples=run.post_samples,
-        post_rule=run.post_rule,
-        nominal_watch=run.nominal_watch,
+        **run.selection(),
     )
     start = time.perf_counter()
     result = evolve(
