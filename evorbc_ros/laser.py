@@ -59,6 +59,8 @@ class LaserToRangefinders:
         self.layout = layout
         self.pose = pose
         self.axes = np.asarray(layout.angles, dtype=np.float64)  # (n,) body frame, rad
+        self._beam_key: tuple | None = None  # the scan geometry _beam_cos_sin last saw
+        self._beam_cos_sin: tuple[np.ndarray, np.ndarray] = (np.empty(0), np.empty(0))
 
     def unseen(self, angle_min: float, angle_increment: float, n_beams: int) -> list[float]:
         """Axes (deg, body frame) of the rangefinders that a scan with this span never covers.
@@ -83,6 +85,23 @@ class LaserToRangefinders:
         """
         half_fov = 0.5 * self.layout.field_of_view
         return (half_fov if half_fov > 0.0 else 0.5 * abs(angle_increment)) + ANGLE_TOLERANCE
+
+    def _cos_sin(
+        self, angle_min: float, angle_increment: float, n_beams: int
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Cosine and sine of each beam's direction in the body frame.
+
+        A scanner publishes the same span in every scan, so they are computed again only
+        when the span (or the scanner's pose) changes: the same operations on the same
+        values, so the same bits as computing them every scan.
+        """
+        key = (float(angle_min), float(angle_increment), n_beams, self.pose)
+        if key != self._beam_key:
+            beam = angle_min + angle_increment * np.arange(n_beams)  # laser frame, rad
+            heading = beam + self.pose.yaw
+            self._beam_cos_sin = (np.cos(heading), np.sin(heading))
+            self._beam_key = key
+        return self._beam_cos_sin
 
     def readings(
         self, angle_min: float, angle_increment: float, ranges, range_min: float, range_max: float
@@ -109,21 +128,21 @@ class LaserToRangefinders:
         if range_max <= 0 or range_min < 0 or range_min > range_max:
             raise InputError(f"range limits [{range_min}, {range_max}] are not valid")
 
-        beam = angle_min + angle_increment * np.arange(r.size)  # laser frame, rad
-        valid = ~np.isnan(r) & ~(np.isfinite(r) & (r < range_min))
+        finite_r = np.isfinite(r)
+        valid = ~np.isnan(r) & ~(finite_r & (r < range_min))
         touching = np.isneginf(r)
-        seen = valid & np.isfinite(r) & (r <= range_max)
+        seen = valid & finite_r & (r <= range_max)
         dist = np.where(seen, r, np.inf)
         dist = np.where(touching, 0.0, dist)
         # Hit points in the body frame. A beam's direction from the body centre comes from
         # its hit point; beams with no return or a zero range use a point 1 m along the beam.
-        heading = beam + self.pose.yaw
-        cos, sin = np.cos(heading), np.sin(heading)
+        cos, sin = self._cos_sin(angle_min, angle_increment, r.size)
         finite = np.isfinite(dist)
         along = np.where(finite & (dist > 0.0), dist, 1.0)
         direction = np.arctan2(self.pose.y + along * sin, self.pose.x + along * cos)
-        hx = self.pose.x + np.where(finite, dist, 0.0) * cos
-        hy = self.pose.y + np.where(finite, dist, 0.0) * sin
+        reached = np.where(finite, dist, 0.0)
+        hx = self.pose.x + reached * cos
+        hy = self.pose.y + reached * sin
         from_centre = np.where(finite, np.hypot(hx, hy), np.inf)
         from_mount = np.maximum(from_centre - self.layout.mount_radius, 0.0)
 

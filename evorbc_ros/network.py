@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property, reduce
+from operator import add
 
 import numpy as np
 
@@ -68,14 +70,23 @@ def _median(values: list[float]) -> float:
     return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2.0
 
 
+def _sum(x: list[float]) -> float:
+    """The terms added one at a time in order, as the compiled kernels add them.
+
+    Not builtin ``sum``: from Python 3.12 on it compensates the rounding of a sum of plain
+    floats (not of numpy scalars), so its last bit would depend on the Python version.
+    """
+    return reduce(add, x, 0.0)
+
+
 # neat-python's aggregations, with its values for a node without inputs.
 AGGREGATIONS = {
-    "sum": lambda x: sum(x, 0.0),
+    "sum": _sum,
     "product": lambda x: math.prod(x, start=1.0),
     "max": lambda x: max(x) if x else 0.0,
     "min": lambda x: min(x) if x else 0.0,
     "maxabs": lambda x: max(x, key=abs) if x else 0.0,
-    "mean": lambda x: sum(x, 0.0) / len(x) if x else 0.0,
+    "mean": lambda x: _sum(x) / len(x) if x else 0.0,
     "median": lambda x: _median(x) if x else 0.0,
 }
 AGGREGATION_IDS = {name: k for k, name in enumerate(AGGREGATIONS)}
@@ -213,14 +224,43 @@ class CompiledNetwork:
         values[: self.n_inputs] = [float(v) for v in inputs]
         activations = list(ACTIVATIONS.values())
         aggregations = list(AGGREGATIONS.values())
-        for k in range(len(self.node_slot)):
-            lo, hi = self.link_start[k], self.link_start[k + 1]
-            terms = [values[self.link_source[j]] * self.link_weight[j] for j in range(lo, hi)]
-            s = aggregations[self.aggregation[k]](terms)
-            values[self.node_slot[k]] = activations[self.activation[k]](
-                self.bias[k] + self.response[k] * s
-            )
+        for slot, bias, response, activation, aggregation, links in self._plan:
+            s = aggregations[aggregation]([values[source] * weight for source, weight in links])
+            values[slot] = activations[activation](bias + response * s)
         return np.array(values[self.n_inputs : self.n_inputs + self.n_outputs])
+
+    @cached_property
+    def _plan(self) -> tuple[tuple, ...]:
+        """The evaluation order as plain Python numbers, one tuple per evaluated node.
+
+        Each holds the node's slot, bias, response, activation and aggregation ids, and
+        its ``(source slot, weight)`` links in file order. Indexing numpy arrays one
+        element at a time costs far more than the arithmetic (the 37-output standard
+        network took about 90 us per activation, 42 us like this); the values are the
+        same IEEE doubles, so the outputs are the same bits (sums: see ``_sum``).
+        """
+        start, source = self.link_start.tolist(), self.link_source.tolist()
+        weight = self.link_weight.tolist()
+        return tuple(
+            (
+                slot,
+                bias,
+                response,
+                activation,
+                aggregation,
+                tuple(zip(source[lo:hi], weight[lo:hi], strict=True)),
+            )
+            for slot, bias, response, activation, aggregation, lo, hi in zip(
+                self.node_slot.tolist(),
+                self.bias.tolist(),
+                self.response.tolist(),
+                self.activation.tolist(),
+                self.aggregation.tolist(),
+                start[:-1],
+                start[1:],
+                strict=True,
+            )
+        )
 
 
 def _num(value, what: str) -> float:

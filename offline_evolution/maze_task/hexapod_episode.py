@@ -105,12 +105,17 @@ class EpisodeRunner:
             self.sims[maze] = HexapodSim(w.geometry, w.physics, w.mazes[maze].boxes)
         return self.sims[maze]
 
-    def inputs(self, sim: HexapodSim, maze: Maze) -> np.ndarray:
-        """The arbitrator's inputs now: laser groups, then goal bearing."""
+    def inputs(self, sim: HexapodSim, maze: Maze, base: tuple | None = None) -> np.ndarray:
+        """The arbitrator's inputs now: laser groups, then goal bearing.
+
+        ``base``: the body's :meth:`~HexapodSim.base_pose` read since the last step, or
+        None to read it now.
+        """
+        base = sim.base_pose() if base is None else base
         s = self.scanner
-        ranges = s.scan(sim)
+        ranges = s.scan(sim, base)
         rf = self.laser.readings(s.angle_min, s.angle_increment, ranges, s.range_min, s.range_max)
-        (x, y, _), orn, _, _ = sim.base_state()
+        (x, y, _), orn = base
         yaw = yaw_from_quaternion(*orn)
         goal = self.goal.readings(x, y, yaw, maze.target[0], maze.target[1])
         return np.concatenate([rf, goal])
@@ -137,19 +142,23 @@ class EpisodeRunner:
         net = network.compile()
         chooser = self.chooser(controller)
         tx, ty = maze.target
-        x, y, heading, _ = sim.pose()
+        # The body's pose is read once per cycle (a PyBullet state request each time) and
+        # serves the pose, the laser and the goal inputs until the next physics step.
+        base = sim.base_pose()
+        x, y, heading, _ = sim.pose(base)
         initial = math.hypot(x - tx, y - ty)
         distance = initial
         reached = fell = False
         poses, choices, outputs = [(x, y, heading)], [], []
         cycles = self.world.n_cycles
         for cycle in range(self.world.n_cycles):
-            out = net.activate(self.inputs(sim, maze))
+            out = net.activate(self.inputs(sim, maze, base))
             index, table, row = chooser.choose(out)
             times = sim.step_times(self.per_period)
             targets = table.joint_targets(times, np.repeat(row, len(times)))
             tilt, _ = sim.run(targets, max_tilt=FALLEN_TILT)
-            x, y, heading, _ = sim.pose()
+            base = sim.base_pose()
+            x, y, heading, _ = sim.pose(base)
             distance = math.hypot(x - tx, y - ty)
             if record:
                 poses.append((x, y, heading))

@@ -267,14 +267,21 @@ class HexapodSim:
         tilt_max = 0.0
         path = 0.0
         (x0, y0, _), _ = get_pose(robot, physicsClientId=c)
-        for target in targets:
-            q = np.fromiter((s[0] for s in get_states(robot, joints, physicsClientId=c)), float, 18)
-            velocity = np.clip(gain * (target - q), -v_max, v_max)
+        # Plain floats, not numpy: 18 joints are too few for numpy's per-call overhead, and
+        # the same IEEE operations in the same order give the same bits. For any x,
+        # ``v if x > v else (-v if x < -v else x)`` is ``np.clip(x, -v, v)`` (NaN included).
+        v_min = -v_max
+        for target in np.asarray(targets, dtype=np.float64).tolist():
+            velocity = []
+            states = get_states(robot, joints, physicsClientId=c)
+            for q_target, state in zip(target, states, strict=True):
+                v = gain * (q_target - state[0])
+                velocity.append(v_max if v > v_max else (v_min if v < v_min else v))
             set_motors(
                 robot,
                 joints,
                 velocity_control,
-                targetVelocities=velocity.tolist(),
+                targetVelocities=velocity,
                 forces=torques,
                 physicsClientId=c,
             )
@@ -292,9 +299,23 @@ class HexapodSim:
 
     # -- reading -------------------------------------------------------------------
 
-    def pose(self) -> tuple[float, float, float, float]:
-        """``(x, y, heading, tilt)`` of the body, world frame, m and rad."""
-        (x, y, _), orn = p.getBasePositionAndOrientation(self.robot, physicsClientId=self.client)
+    def base_pose(self) -> tuple[tuple, tuple]:
+        """Body position (m) and orientation (xyzw quaternion), world frame.
+
+        Each read asks PyBullet for the whole robot's state; a caller that needs the pose
+        several times between two steps reads it once and passes it to :meth:`pose` and
+        :meth:`laser` (the episode loop does, once per control cycle).
+        """
+        return p.getBasePositionAndOrientation(self.robot, physicsClientId=self.client)
+
+    def pose(self, base: tuple | None = None) -> tuple[float, float, float, float]:
+        """``(x, y, heading, tilt)`` of the body, world frame, m and rad.
+
+        Args:
+            base: :meth:`base_pose` read since the last step, or None to read it now.
+
+        """
+        (x, y, _), orn = self.base_pose() if base is None else base
         return x, y, _yaw(orn), _tilt(orn)
 
     def base_state(self) -> tuple[tuple, tuple, tuple, tuple]:
@@ -313,27 +334,28 @@ class HexapodSim:
             np.array([s[3] for s in states]),
         )
 
-    def laser(self, angles: np.ndarray, max_range: float, height: float) -> np.ndarray:
+    def laser(
+        self, angles: np.ndarray, max_range: float, height: float, base: tuple | None = None
+    ) -> np.ndarray:
         """A 2D laser on the body: distances (m) to walls along ``angles`` (rad, body yaw).
 
         Rays stay horizontal at ``height`` m above the ground whatever the body's tilt
         (a 2D scanner levelled in the ground plane); no hit within ``max_range`` gives
-        +inf (REP 117).
+        +inf (REP 117). ``base``: as in :meth:`pose`.
         """
-        x, y, heading, _ = self.pose()
+        x, y, heading, _ = self.pose(base)
         if not self.walls:
             return np.full(len(angles), np.inf)
         world = heading + np.asarray(angles, dtype=np.float64)
+        # rayTestBatch takes lists: build them directly rather than through a (beams, 3)
+        # array (same arithmetic, less numpy overhead per scan).
+        height = float(height)
+        end_x = (x + max_range * np.cos(world)).tolist()
+        end_y = (y + max_range * np.sin(world)).tolist()
         start = [[x, y, height]] * len(world)
-        end = np.column_stack(
-            [
-                x + max_range * np.cos(world),
-                y + max_range * np.sin(world),
-                np.full_like(world, height),
-            ]
-        )
+        end = [[ex, ey, height] for ex, ey in zip(end_x, end_y, strict=True)]
         hits = p.rayTestBatch(
-            start, end.tolist(), collisionFilterMask=WALL_GROUP, physicsClientId=self.client
+            start, end, collisionFilterMask=WALL_GROUP, physicsClientId=self.client
         )
         return np.array([h[2] * max_range if h[0] >= 0 else np.inf for h in hits])
 

@@ -59,7 +59,12 @@ class Scanner:
         """Beam directions (rad, body frame), computed as the laser node computes them."""
         return self.angle_min + self.angle_increment * np.arange(self.beams)
 
-    def scan(self, sim: HexapodSim) -> np.ndarray:
-        """``(beams,)`` float32 ranges (m) from the robot in ``sim``; +inf: no return."""
-        height = sim.base_state()[0][2] + self.mount_height
-        return sim.laser(self.angles(), self.range_max, height).astype(np.float32)
+    def scan(self, sim: HexapodSim, base: tuple | None = None) -> np.ndarray:
+        """``(beams,)`` float32 ranges (m) from the robot in ``sim``; +inf: no return.
+
+        ``base``: the body's :meth:`~HexapodSim.base_pose` read since the last step, or
+        None to read it now.
+        """
+        base = sim.base_pose() if base is None else base
+        height = base[0][2] + self.mount_height
+        return sim.laser(self.angles(), self.range_max, height, base).astype(np.float32)
