@@ -5,7 +5,7 @@
 
 Arguments: robot (4ws-5 or another 4WS type, or hexapod), maze (default: obstacle, or
 hexapod for the hexapod), mode (lockstep|realtime), gui, arbitrator and repertoire
-(files; empty for the shipped ones, which exist for 4ws-5 only so far). Node parameters
+(files; empty for the shipped ones, which exist for 4ws-5 and the hexapod). Node parameters
 come from config/ros/*.yaml of the package; the hexapod's episode is 30 s.
 The same graph starts without ROS 2's launch via ``evorbc-sim``.
 """
