@@ -79,6 +79,13 @@ class GraphRun:
         self.bridge.wait(timeout)
         return json.loads(self.result.read_text())
 
+    def finish(self, timeout):
+        """The bridge's episode result; every process is stopped whatever happens."""
+        try:
+            return self.wait(timeout)
+        finally:
+            self.stop()
+
     def recorded_choices(self):
         """The primitive the arbitrator chose at each cycle (its record file)."""
         rows = [json.loads(line) for line in self.choices.read_text().splitlines()]
@@ -95,3 +102,15 @@ class GraphRun:
                 p.kill()
                 p.wait()
         self.log.close()
+
+
+def assert_same_choices(choices, result, k=0):
+    """The graph chose offline episode ``k``'s primitive at each of its cycles.
+
+    The bridge's final state may draw one more choice, which is never applied. Returns the
+    episode's number of cycles.
+    """
+    cycles = int(result.cycles[k])
+    assert len(choices) in (cycles, cycles + 1)
+    np.testing.assert_array_equal(choices[:cycles], result.choice[k, :cycles])
+    return cycles

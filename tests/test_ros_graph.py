@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from graph_helpers import GraphRun, graph_env
+from graph_helpers import GraphRun, assert_same_choices, graph_env
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.defaults import default_arbitrator, default_repertoire
@@ -35,17 +35,8 @@ def offline():
 def test_lockstep_graph_makes_the_offline_choices_and_reaches_the_target(tmp_path, offline, k):
     outcomes, result = offline
     run = GraphRun(tmp_path, 150 + k, MAZES[k])
-    try:
-        got = run.wait(timeout=120)
-    finally:
-        run.stop()
-    cycles = int(result.cycles[k])
-    want = result.choice[k, :cycles]
-    choices = run.recorded_choices()
-    # The same primitive at every cycle; the bridge's final state may draw one more choice,
-    # which is never applied.
-    assert len(choices) in (cycles, cycles + 1)
-    np.testing.assert_array_equal(choices[:cycles], want)
+    got = run.finish(timeout=120)
+    cycles = assert_same_choices(run.recorded_choices(), result, k)
     trajectory = np.array(got["trajectory"])
     np.testing.assert_allclose(trajectory, result.pose[k, : cycles + 1], atol=1e-9)
     assert got["time"] == pytest.approx(outcomes[k].time, abs=1e-9)

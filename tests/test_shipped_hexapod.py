@@ -4,7 +4,7 @@ choices and reaches it too."""
 
 import numpy as np
 import pytest
-from graph_helpers import GraphRun
+from graph_helpers import GraphRun, assert_same_choices
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.defaults import default_arbitrator, default_repertoire
@@ -47,14 +47,8 @@ def test_lockstep_graph_walks_the_shipped_controller_to_the_target(tmp_path, off
         tmp_path, 171, "hexapod", episode_time=30.0,
         arbitrator=default_arbitrator("hexapod"), robot="hexapod",
     )  # fmt: skip
-    try:
-        got = run.wait(timeout=300)
-    finally:
-        run.stop()
-    cycles = int(result.cycles[0])
-    choices = run.recorded_choices()
-    assert len(choices) in (cycles, cycles + 1)
-    np.testing.assert_array_equal(choices[:cycles], result.choice[0, :cycles])
+    got = run.finish(timeout=300)
+    cycles = assert_same_choices(run.recorded_choices(), result)
     trajectory = np.array(got["trajectory"])
     np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
     assert got["reached"] and got["time"] == pytest.approx(outcome.time)
