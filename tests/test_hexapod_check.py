@@ -36,23 +36,29 @@ def runs(tmp_path_factory):
     layout = SensorLayout.load(config_dir() / "sensors" / "hexapod.yaml")
     config = neat_config(6, 2, path="config/neat/hexapod.ini")
     runs = ((1, 1.2, 6, (0.9, 0.5, None)), (2, 1.3, None, (0.7, 0.1, "nominal_then_mean")))
+    sizes = {"evorbc": [], "standard": []}  # neat-python's own count: genome.size()
     for seed, best, first, post in runs:
+        genome = random_genomes(config, 1, seed=seed)[0]
+        sizes["evorbc"].append(sum(genome.size()))
         ArbitratorFile(
             kind="evorbc", robot="hexapod", sensors=layout, mapping="polar",
-            network=network_spec(random_genomes(config, 1, seed=seed)[0], config),
+            network=network_spec(genome, config),
             repertoire={"fingerprint": rep.fingerprint(), "robot": "hexapod", "count": 6},
             evolution=evolution(seed, best, first, *post),
         ).save(out / f"evorbc-seed{seed}.json")  # fmt: skip
     config37 = neat_config(6, 37, path="config/neat/hexapod.ini")
+    genome = random_genomes(config37, 1, seed=3)[0]
+    sizes["standard"].append(sum(genome.size()))
     ArbitratorFile(
         kind="standard", robot="hexapod", sensors=layout, parameters=parameter_specs(),
-        network=network_spec(random_genomes(config37, 1, seed=3)[0], config37),
+        network=network_spec(genome, config37),
         evolution=evolution(1, 0.4, None, 0.3, 0.0),
     ).save(out / "standard-seed1.json")  # fmt: skip
-    return out
+    return out, sizes
 
 
 def test_summary_reports_the_runs_next_to_the_paper(runs):
+    runs, sizes = runs
     text = summarise(runs / "rep.json", runs, [1, 2, 3], [1])
     rows = {line.split(" | ")[0]: line for line in text.splitlines()}
     assert "| 6 primitives" in rows["| repertoire size"]
@@ -67,4 +73,8 @@ def test_summary_reports_the_runs_next_to_the_paper(runs):
     assert any(k.startswith("| primitive switches") for k in rows)
     std = rows["| standard NEAT, 1 run(s) of 10 generations"]
     assert "best fitness 0.40, goal reached in 0 of 1" in std and "% of the way" in std
+    size = next(v for k, v in rows.items() if k.startswith("| network size"))
+    evo_size = (sizes["evorbc"][0] + sizes["evorbc"][1]) / 2
+    assert f"EvoRBC {evo_size:.1f} (2 run(s)), standard NEAT {sizes['standard'][0]:.1f} (1" in size
+    assert sizes["standard"][0] > max(sizes["evorbc"])  # 37 outputs against 2
     assert (runs / "hexapod-check.md").read_text() == text

@@ -10,7 +10,7 @@ Then reports, next to the paper's values: the repertoire's size, quality and lef
 symmetry; EvoRBC's best fitness (mean +- sd), how many runs reached the goal and the first
 generation that did; how far standard NEAT got (eq. 5 fitness, 1 - d_final/d_initial when
 it does not arrive, and how far along the maze its controller walks); and how often the
-selected arbitrator switches primitive.
+selected arbitrator switches primitive; and how large the written networks are.
 
 Every run checkpoints each generation and resumes when the experiment is started again;
 finished runs are skipped.
@@ -40,6 +40,8 @@ PAPER = {
     "evorbc": "1.28 ± 0.02, goal reached in 5 of 5 runs, about 25 generations to first reach",
     "standard": "about the middle of the maze",
     "switch": "about every 1.9 cycles",
+    # Appendix E: mean over the best controllers, output and hidden neurons plus synapses
+    "size": "EvoRBC 37.6, standard NEAT 277.6",
 }
 
 
@@ -191,9 +193,36 @@ def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: lis
             f"selected controller from the nominal start: {how_far} along the maze | "
             f"{PAPER['standard']} |"
         )
+    sizes = {
+        kind: [network_size(out / f"{kind}-seed{k}.json") for k in ks]
+        for kind, ks in (("evorbc", seeds), ("standard", standard_seeds))
+    }
+    sizes = {kind: [s for s in v if s is not None] for kind, v in sizes.items()}
+    if any(sizes.values()):
+        parts = [
+            f"{name} {np.mean(sizes[kind]):.1f} ({len(sizes[kind])} run(s))"
+            for kind, name in (("evorbc", "EvoRBC"), ("standard", "standard NEAT"))
+            if sizes[kind]
+        ]
+        lines.append(
+            "| network size of the written controllers (output and hidden neurons plus "
+            f"enabled synapses) | {', '.join(parts)} | {PAPER['size']} |"
+        )
     text = "\n".join(lines) + "\n"
     atomic_write_text(out / "hexapod-check.md", text)
     return text
+
+
+def network_size(path: Path) -> int | None:
+    """Neurons (output and hidden) plus enabled synapses of a run file's network.
+
+    neat-python's ``DefaultGenome.size()`` counts the same two things, which is how the
+    paper's Appendix E reports network sizes. None if the run has not finished.
+    """
+    if not path.exists():
+        return None
+    net = ArbitratorFile.load(path).network
+    return len(net.nodes) + sum(c.enabled for c in net.connections)
 
 
 def _evolution(path: Path) -> dict | None:
