@@ -168,6 +168,38 @@ def test_post_evaluation_settings_may_change_on_resume(tmp_path, small_neat_file
     assert result.post_evaluation.episodes == 2 * (1 + 3)  # two mazes
 
 
+def test_a_run_resumes_with_its_neat_file_elsewhere_but_not_edited(
+    tmp_path, small_neat_file, small_repertoire
+):
+    # A long run carried to another checkout or machine finds its NEAT settings at another
+    # path; only their contents decide whether the population may continue.
+    s = settings(small_neat_file, generations=4, repertoire=small_repertoire)
+    straight = evolve(s, small_repertoire)
+    ckpt = tmp_path / "c.json"
+    with pytest.raises(Interrupted):
+        evolve(s, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    moved = tmp_path / "elsewhere" / "neat.ini"
+    moved.parent.mkdir()
+    moved.write_text(small_neat_file.read_text())
+    same(
+        straight,
+        evolve(
+            settings(moved, generations=4, repertoire=small_repertoire),
+            small_repertoire,
+            checkpoint=ckpt,
+        ),
+    )
+    with pytest.raises(Interrupted):
+        evolve(s, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    moved.write_text(small_neat_file.read_text() + "\n# edited\n")
+    with pytest.raises(CheckpointError, match="neat_sha256 is"):
+        evolve(
+            settings(moved, generations=4, repertoire=small_repertoire),
+            small_repertoire,
+            checkpoint=ckpt,
+        )
+
+
 class _ScoredTask:
     """Stands in for MazeTask.evaluate with fixed per-episode outcomes (rule logic only)."""
 

@@ -62,6 +62,9 @@ EQUAL_BUDGET_GENERATIONS = {"4ws": 25, "hexapod": 455}
 #: EvolutionSettings fields that only decide which genome is written, never how the
 #: population evolves, so they may change when a run resumes from a checkpoint.
 SELECTION_ONLY = ("post_samples", "post_rule", "nominal_watch")
+#: Fields that say where an input lies, not what it holds: the NEAT file's contents are
+#: checked by ``neat_sha256``, so a run resumes in another checkout or folder.
+LOCATION_ONLY = ("neat_file",)
 
 
 @dataclass(frozen=True)
@@ -320,10 +323,11 @@ class Evolution:
             raise CheckpointError(f"{path}: not a NEAT evolution checkpoint", discardable=False)
         if not isinstance(data.get("settings"), dict):
             raise CheckpointError(f"{path}: not a usable checkpoint (settings missing)")
-        # Selection settings never change the population, so they may change between
-        # sessions without touching finished work.
+        # Selection settings never change the population, and a file's location never
+        # changes its contents, so both may change between sessions.
+        ignored = SELECTION_ONLY + LOCATION_ONLY
         saved, now = (
-            {k: v for k, v in d.items() if k not in SELECTION_ONLY}
+            {k: v for k, v in d.items() if k not in ignored}
             for d in (data["settings"], self.settings.as_dict())
         )
         mismatch = settings_mismatch(saved, now)
