@@ -1,5 +1,7 @@
 """The hexapod paper-check summary: the figures it reports come from the run files."""
 
+import json
+
 import pytest
 from hexapod_helpers import tripod_repertoire
 from neat_helpers import neat_config, network_spec, random_genomes
@@ -8,6 +10,7 @@ from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.config import config_dir
 from evorbc_ros.robots.hexapod import parameter_specs
 from evorbc_ros.sensors import SensorLayout
+from offline_evolution.checkpoint import CheckpointError
 from offline_evolution.experiments.hexapod_check import summarise
 
 TASK = {"mazes": ["hexapod"], "episode_time": 2.0, "samples_per_maze": 1,
@@ -78,3 +81,20 @@ def test_summary_reports_the_runs_next_to_the_paper(runs):
     assert f"EvoRBC {evo_size:.1f} (2 run(s)), standard NEAT {sizes['standard'][0]:.1f} (1" in size
     assert sizes["standard"][0] > max(sizes["evorbc"])  # 37 outputs against 2
     assert (runs / "hexapod-check.md").read_text() == text
+
+
+def test_an_unfinished_standard_run_is_reported_from_its_checkpoint(runs, tmp_path):
+    runs, _ = runs
+    # 660 generations (200 + the 455 of the equal budget + 5 more than run): the row
+    # reports how far it has got and the best so far at EvoRBC's budget, generation 200
+    best = [0.1 + 0.001 * g for g in range(250)]
+    history = [{"best_so_far": b, "best_reached": 0} for b in best]
+    ckpt = {"settings": {"generations": 660}, "history": history}
+    (tmp_path / "standard-seed1.json.checkpoint.json").write_text(json.dumps(ckpt))
+    text = summarise(runs / "rep.json", tmp_path, [], [1])
+    row = next(line for line in text.splitlines() if "still running" in line)
+    assert "seed 1: generation 250 of 660, best fitness so far 0.35 (generation 250)" in row
+    assert "goal not reached; 0.30 at generation 205 (EvoRBC's budget)" in row
+    (tmp_path / "standard-seed1.json.checkpoint.json").write_text('{"settings": {}}')
+    with pytest.raises(CheckpointError, match="not a NEAT checkpoint with a generation history"):
+        summarise(runs / "rep.json", tmp_path, [], [1])

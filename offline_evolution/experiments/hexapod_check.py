@@ -12,8 +12,10 @@ generation that did; how far standard NEAT got (eq. 5 fitness, 1 - d_final/d_ini
 it does not arrive, and how far along the maze its controller walks); and how often the
 selected arbitrator switches primitive; and how large the written networks are.
 
-Every run checkpoints each generation and resumes when the experiment is started again;
-finished runs are skipped.
+Every run checkpoints as it goes and resumes when the experiment is started again;
+finished runs are skipped. A standard run that has not finished (655 generations outlast
+a working session) is reported from its checkpoint: how far it has got and its best
+fitness so far, also at EvoRBC's budget of generations.
 
 Run: ``python -m offline_evolution.experiments.hexapod_check --repertoire REP.json
 --out DIR [--seeds 3] [--standard-seeds 1] [--summarise-only]``
@@ -32,6 +34,8 @@ from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.config import build_settings
 from evorbc_ros.repertoire import Repertoire, RepertoireError
+from offline_evolution.arbitrator.evolve import EQUAL_BUDGET_GENERATIONS
+from offline_evolution.checkpoint import CheckpointError, load_json_checkpoint
 from offline_evolution.repertoire.stats import repertoire_stats
 
 PAPER = {
@@ -193,6 +197,15 @@ def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: lis
             f"selected controller from the nominal start: {how_far} along the maze | "
             f"{PAPER['standard']} |"
         )
+    running = [(k, _progress(out / f"standard-seed{k}.json")) for k in standard_seeds]
+    running = [(k, p) for k, p in running if p is not None]
+    if running:
+        # A 655-generation run outlasts a working session; what its checkpoint holds so
+        # far is worth reporting, as at EvoRBC's own budget of generations.
+        parts = "; ".join(f"seed {k}: {p}" for k, p in running)
+        lines.append(
+            f"| standard NEAT still running (its checkpoint) | {parts} | {PAPER['standard']} |"
+        )
     sizes = {
         kind: [network_size(out / f"{kind}-seed{k}.json") for k in ks]
         for kind, ks in (("evorbc", seeds), ("standard", standard_seeds))
@@ -225,6 +238,38 @@ def network_size(path: Path) -> int | None:
     return len(net.nodes) + sum(c.enabled for c in net.connections)
 
 
+def _progress(path: Path) -> str | None:
+    """How far an unfinished run has got, from its checkpoint next to ``path``.
+
+    None if the run has finished or has no checkpoint.
+
+    Raises:
+        CheckpointError: the checkpoint is unreadable or lacks its generation history.
+
+    """
+    ckpt = path.with_name(path.name + ".checkpoint.json")
+    if path.exists() or not ckpt.exists():
+        return None
+    data = load_json_checkpoint(ckpt)
+    try:
+        total = int(data["settings"]["generations"])
+        best = [float(h["best_so_far"]) for h in data["history"]]
+        reached = any(h["best_reached"] >= 1 for h in data["history"])
+    except (KeyError, TypeError, ValueError):
+        raise CheckpointError(f"{ckpt}: not a NEAT checkpoint with a generation history") from None
+    if not best:
+        return f"generation 0 of {total}"
+    # 1-based generations, as the CLI's progress lines count them
+    text = (
+        f"generation {len(best)} of {total}, best fitness so far {best[-1]:.2f} "
+        f"(generation {int(np.argmax(best)) + 1}), goal {'reached' if reached else 'not reached'}"
+    )
+    base = total - EQUAL_BUDGET_GENERATIONS["hexapod"]
+    if 0 < base <= len(best):
+        text += f"; {best[base - 1]:.2f} at generation {base} (EvoRBC's budget)"
+    return text
+
+
 def _evolution(path: Path) -> dict | None:
     """The ``evolution`` record of a finished run's file, or None if not run yet."""
     return ArbitratorFile.load(path).evolution if path.exists() else None
@@ -249,7 +294,7 @@ def main() -> None:
         if not args.summarise_only:
             run_all(args.repertoire, args.out, seeds, standard)
         print(summarise(args.repertoire, args.out, seeds, standard))
-    except (RepertoireError, ArbitratorError, OSError) as e:
+    except (RepertoireError, ArbitratorError, CheckpointError, OSError) as e:
         raise SystemExit(f"hexapod_check: error: {e}") from None
 
 
