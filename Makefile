@@ -34,7 +34,7 @@ demo-repertoire: $(STAMP)
 		--out $(OUT)/4ws-5.repertoire.json --plot $(OUT)/4ws-5.repertoire.png \
 		--csv $(OUT)/4ws-5.repertoire.csv
 
-# A whole EvoRBC run: repertoire, then 1000 generations of NEAT (about 6 min on 2 cores).
+# A whole EvoRBC run: repertoire, then 1000 generations of NEAT (about 8-10 min on 2 cores).
 demo-evolve: demo-repertoire
 	$(VENV)/bin/evorbc-evolve arbitrator --repertoire $(OUT)/4ws-5.repertoire.json --seed 1 \
 		--out $(OUT)/4ws-5.arbitrator.json

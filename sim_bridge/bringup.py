@@ -74,7 +74,7 @@ def parse_args(argv=None) -> argparse.Namespace:
         choices=ROBOTS,
         default="",
         help="robot whose shipped controller runs (default: the arbitrator file's, else 4ws-5; "
-        "only 4ws-5 ships one so far)",
+        "4ws-5 and hexapod ship one)",
     )
     p.add_argument(
         "--maze",
