@@ -202,3 +202,19 @@ def test_restart_deletes_only_a_neat_checkpoint(tmp_path, capsys, small_repertoi
     assert code == 1 and "--restart does not delete it" in err and precious.exists()
     code, _, err = run(capsys, "arbitrator", "--repertoire", rep, "--out", rep)
     assert code == 1 and "is the same file as --out" in err and rep.exists()
+
+
+def test_progress_says_when_a_run_resumes_from_its_checkpoint(capsys):
+    from offline_evolution.arbitrator.evolve import GenerationStats
+    from offline_evolution.commands.arbitrator import _GenerationPrinter
+
+    def lines(first_generation):
+        printer = _GenerationPrinter(quiet=False, total=655)
+        for g in (first_generation, first_generation + 1):
+            printer(GenerationStats(g, 0.4, 0.1, 0.4, 3, 26.0, 25.0, 0), None)
+        return capsys.readouterr().err.splitlines()
+
+    fresh, resumed = lines(0), lines(100)
+    assert [line.split()[1] for line in fresh] == ["1/655", "2/655"]
+    assert resumed[0] == "resuming from the checkpoint: generations 1-100 of 655 are done"
+    assert [line.split()[1] for line in resumed[1:]] == ["101/655", "102/655"]

@@ -103,6 +103,14 @@ class _GenerationPrinter:
     def __call__(self, stats, settings) -> None:
         if self.quiet:
             return
+        if not self.announced:
+            self.announced = True
+            if stats.generation > 0:  # the first generation run here was not the run's first
+                print(
+                    f"resuming from the checkpoint: generations 1-{stats.generation} of "
+                    f"{self.total} are done",
+                    file=sys.stderr,
+                )
         remaining = (self.total - stats.generation - 1) * stats.seconds
         print(
             f"generation {stats.generation + 1:>4}/{self.total}  best {stats.best:6.3f}  "
