@@ -218,3 +218,16 @@ def test_progress_says_when_a_run_resumes_from_its_checkpoint(capsys):
     assert [line.split()[1] for line in fresh] == ["1/655", "2/655"]
     assert resumed[0] == "resuming from the checkpoint: generations 1-100 of 655 are done"
     assert [line.split()[1] for line in resumed[1:]] == ["101/655", "102/655"]
+
+
+def test_the_eta_is_not_thrown_by_one_slow_generation(capsys):
+    from offline_evolution.arbitrator.evolve import GenerationStats
+    from offline_evolution.commands.arbitrator import _GenerationPrinter
+
+    printer = _GenerationPrinter(quiet=False, total=110)
+    for g, seconds in enumerate([30.0, 30.0, 300.0, 30.0]):  # generation 3 paused 270 s
+        printer(GenerationStats(g, 0.4, 0.1, 0.4, 3, seconds, seconds, 0), None)
+    lines = capsys.readouterr().err.splitlines()
+    # 107 generations left at 30 s each, the slow one shown as it was but not projected
+    assert "300.00 s/gen  eta  53.5 min" in lines[2]
+    assert lines[3].endswith("30.00 s/gen  eta  53.0 min")

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import statistics
 import sys
+from collections import deque
 from pathlib import Path
 
 from evorbc_ros.repertoire import Repertoire
@@ -99,6 +101,9 @@ class _GenerationPrinter:
         self.quiet = quiet
         self.total = total
         self.announced = False
+        # The ETA uses the median of recent generations (s), so one slow generation (the
+        # machine busy, the run paused) does not make it jump tenfold.
+        self.recent: deque[float] = deque(maxlen=10)
 
     def __call__(self, stats, settings) -> None:
         if self.quiet:
@@ -111,7 +116,8 @@ class _GenerationPrinter:
                     f"{self.total} are done",
                     file=sys.stderr,
                 )
-        remaining = (self.total - stats.generation - 1) * stats.seconds
+        self.recent.append(stats.seconds)
+        remaining = (self.total - stats.generation - 1) * statistics.median(self.recent)
         print(
             f"generation {stats.generation + 1:>4}/{self.total}  best {stats.best:6.3f}  "
             f"mean {stats.mean:6.3f}  best so far {stats.best_so_far:6.3f}  "
