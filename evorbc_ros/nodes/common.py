@@ -146,6 +146,21 @@ def load_sensor_layout(path: str):
         raise StartupError(f"parameter sensor_layout: {e}") from None
 
 
+def sensor_layout_parameter(node: Node):
+    """Declare a sensor node's ``sensor_layout`` parameter and load the layout it names.
+
+    Raises:
+        StartupError: naming the file and the problem.
+    """
+    path = declare(
+        node,
+        "sensor_layout",
+        "",
+        "sensor layout YAML or arbitrator JSON; empty: the shipped 4WS layout",
+    )
+    return load_sensor_layout(path)
+
+
 def finite_parameter(
     node: Node, name: str, default: float, description: str, positive: bool = False
 ) -> float:

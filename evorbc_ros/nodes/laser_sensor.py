@@ -22,8 +22,8 @@ from evorbc_ros.nodes.common import (
     StartupError,
     declare,
     finite_parameter,
-    load_sensor_layout,
     run_node,
+    sensor_layout_parameter,
     vector_message,
 )
 
@@ -33,14 +33,7 @@ class LaserSensorNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__("laser_sensor", **kwargs)
-        layout = load_sensor_layout(
-            declare(
-                self,
-                "sensor_layout",
-                "",
-                "sensor layout YAML or arbitrator JSON; empty: the shipped 4WS layout",
-            )
-        )
+        layout = sensor_layout_parameter(self)
         if layout.rangefinders is None:
             raise StartupError("parameter sensor_layout: the layout has no rangefinders")
         pose = LaserPose(

@@ -24,8 +24,8 @@ from evorbc_ros.nodes.common import (
     SENSOR_DATA,
     StartupError,
     declare,
-    load_sensor_layout,
     run_node,
+    sensor_layout_parameter,
     vector_message,
 )
 
@@ -35,14 +35,7 @@ class RadarSensorNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__("radar_sensor", **kwargs)
-        layout = load_sensor_layout(
-            declare(
-                self,
-                "sensor_layout",
-                "",
-                "sensor layout YAML or arbitrator JSON; empty: the shipped 4WS layout",
-            )
-        )
+        layout = sensor_layout_parameter(self)
         try:
             self.inputs = GoalInputs(layout)
         except ValueError as e:
