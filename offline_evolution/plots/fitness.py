@@ -46,7 +46,12 @@ def plot_fitness_comparison(
         length = min(len(r) for r in runs)
         curves = np.array([np.maximum.accumulate(np.asarray(r[:length])) for r in runs])
         gen = np.arange(1, length + 1)
-        (line,) = ax.plot(gen, curves.mean(axis=0), lw=1.8, label=f"{label} ({len(runs)} runs)")
+        (line,) = ax.plot(
+            gen,
+            curves.mean(axis=0),
+            lw=1.8,
+            label=f"{label} ({len(runs)} run{'' if len(runs) == 1 else 's'})",
+        )
         ax.fill_between(
             gen, curves.min(axis=0), curves.max(axis=0), color=line.get_color(), alpha=0.2, lw=0
         )

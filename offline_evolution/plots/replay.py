@@ -22,12 +22,18 @@ def plot_trajectories(
 ) -> None:
     """Each episode's path (colour = time) over its maze, with start, end and result."""
     n = len(outcomes)
+    mazes = {m.name: m for m in task.mazes}
+    # Rows are as tall as the widest-for-its-height maze needs to fill about 10 in of the
+    # 12 in width (the rest is labels and the colour bar): the 11 x 1.4 m 4WS mazes keep
+    # 2.1 in rows, the 8 x 2 m hexapod maze gets taller ones instead of a narrow strip.
+    aspect = max(w / h for w, h in (mazes[o.maze].size() for o in outcomes))
+    row = max(2.1, 10.0 / aspect + 0.6)
     fig, axes = plt.subplots(
-        n, 1, figsize=(12.0, 2.1 * n + 0.4), squeeze=False, layout="constrained"
+        n, 1, figsize=(12.0, row * n + 0.4), squeeze=False, layout="constrained"
     )
     cmap = plt.get_cmap("viridis")
     for e, (ax, o) in enumerate(zip(axes[:, 0], outcomes, strict=True)):
-        maze = next(m for m in task.mazes if m.name == o.maze)
+        maze = mazes[o.maze]
         draw_maze(ax, maze)
         cycles = int(result.cycles[e])
         xy = result.pose[e, : cycles + 1, :2]
