@@ -17,14 +17,15 @@ TASK = {"mazes": ["hexapod"], "episode_time": 2.0, "samples_per_maze": 1,
         "sensors": "sensors/hexapod.yaml"}  # fmt: skip
 
 
-def evolution(seed, best, first_reach, post_fitness, post_reached, rule=None):
-    """An ``evolution`` record as the CLI writes it, 10 generations long."""
+def evolution(seed, best, first_reach, post_fitness, post_reached, rule=None, generations=10):
+    """An ``evolution`` record as the CLI writes it; fitness climbs 0.01 a generation."""
     history = [
-        {"generation": g, "best_reached": int(first_reach is not None and g >= first_reach)}
-        for g in range(10)
-    ]
+        {"generation": g, "best_reached": int(first_reach is not None and g >= first_reach),
+         "best": 0.01 * g, "best_so_far": 0.01 * g}
+        for g in range(generations)
+    ]  # fmt: skip
     return {
-        "seed": seed, "generations": 10, "best_fitness": best, "history": history,
+        "seed": seed, "generations": generations, "best_fitness": best, "history": history,
         "best_reached": int(first_reach is not None), "task": TASK,
         "post_evaluation": {"fitness": post_fitness, "reached": post_reached,
                             "episodes_per_candidate": 21, **({"rule": rule} if rule else {})},
@@ -55,7 +56,8 @@ def runs(tmp_path_factory):
     ArbitratorFile(
         kind="standard", robot="hexapod", sensors=layout, parameters=parameter_specs(),
         network=network_spec(genome, config37),
-        evolution=evolution(1, 0.4, None, 0.3, 0.0),
+        # 5 + the 455 of the equal budget, so EvoRBC's budget is 5 generations
+        evolution=evolution(1, 0.4, None, 0.3, 0.0, generations=460),
     ).save(out / "standard-seed1.json")  # fmt: skip
     return out, sizes
 
@@ -74,13 +76,18 @@ def test_summary_reports_the_runs_next_to_the_paper(runs):
     assert "seed 1 (rule mean): 0.90, reached 50 % of 21, misses from the nominal start" in post
     assert "seed 2 (rule nominal_then_mean): 0.70, reached 10 % of 21, misses" in post
     assert any(k.startswith("| primitive switches") for k in rows)
-    std = rows["| standard NEAT, 1 run(s) of 10 generations"]
-    assert "best fitness 0.40, goal reached in 0 of 1" in std and "% of the way" in std
+    std = rows["| standard NEAT, 1 run(s) of 460 generations"]
+    # generation 5 is history entry 4: best so far 0.04
+    assert (
+        "best fitness 0.40 (0.04 at generation 5, EvoRBC's budget), goal reached in 0 of 1" in std
+    )
+    assert "% of the way" in std
     size = next(v for k, v in rows.items() if k.startswith("| network size"))
     evo_size = (sizes["evorbc"][0] + sizes["evorbc"][1]) / 2
     assert f"EvoRBC {evo_size:.1f} (2 run(s)), standard NEAT {sizes['standard'][0]:.1f} (1" in size
     assert sizes["standard"][0] > max(sizes["evorbc"])  # 37 outputs against 2
     assert (runs / "hexapod-check.md").read_text() == text
+    assert (runs / "hexapod-check.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_an_unfinished_standard_run_is_reported_from_its_checkpoint(runs, tmp_path):

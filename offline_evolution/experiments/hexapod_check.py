@@ -9,8 +9,10 @@ through the CLI, so every run is a command a user can repeat:
 Then reports, next to the paper's values: the repertoire's size, quality and left/right
 symmetry; EvoRBC's best fitness (mean +- sd), how many runs reached the goal and the first
 generation that did; how far standard NEAT got (eq. 5 fitness, 1 - d_final/d_initial when
-it does not arrive, and how far along the maze its controller walks); and how often the
-selected arbitrator switches primitive; and how large the written networks are.
+it does not arrive, also at EvoRBC's budget of generations, and how far along the maze its
+controller walks); how often the selected arbitrator switches primitive; and how large the
+written networks are. The fitness curves of the finished runs (paper Fig. 17) go beside the
+table as a picture.
 
 Every run checkpoints as it goes and resumes when the experiment is started again;
 finished runs are skipped. A standard run that has not finished (655 generations outlast
@@ -122,7 +124,10 @@ def replay_nominal(arbitrator: Path, repertoire: Path | None) -> dict:
 
 
 def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: list[int]) -> str:
-    """The Markdown comparison with the paper, written to ``OUT/hexapod-check.md``."""
+    """The Markdown comparison with the paper, written to ``OUT/hexapod-check.md``.
+
+    The fitness curves of the finished runs (paper Fig. 17) go to ``OUT/hexapod-check.png``.
+    """
     rep = Repertoire.load(repertoire)
     s = repertoire_stats(rep)
     lines = [
@@ -190,9 +195,17 @@ def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: lis
             "reached the goal" if w["reached"] else f"{100 * w['progress']:.0f} % of the way"
             for w in walks
         )
+        base = std[0]["generations"] - EQUAL_BUDGET_GENERATIONS["hexapod"]
+        at_base = (
+            # what standard NEAT had after as many generations as EvoRBC ran
+            f" ({np.mean([e['history'][base - 1]['best_so_far'] for e in std]):.2f} at "
+            f"generation {base}, EvoRBC's budget)"
+            if 0 < base <= min(len(e["history"]) for e in std)
+            else ""
+        )
         lines.append(
             f"| standard NEAT, {len(std)} run(s) of {std[0]['generations']} generations | "
-            f"best fitness {best.mean():.2f}, goal reached in "
+            f"best fitness {best.mean():.2f}{at_base}, goal reached in "
             f"{sum(e['best_reached'] >= 1 for e in std)} of {len(std)} in training; the "
             f"selected controller from the nominal start: {how_far} along the maze | "
             f"{PAPER['standard']} |"
@@ -220,6 +233,16 @@ def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: lis
         lines.append(
             "| network size of the written controllers (output and hidden neurons plus "
             f"enabled synapses) | {', '.join(parts)} | {PAPER['size']} |"
+        )
+    if evo or std:
+        from offline_evolution.plots.fitness import plot_fitness_comparison
+
+        # the paper's Fig. 17: highest fitness so far, mean over runs with the min-max band
+        groups = {"EvoRBC": evo, "standard NEAT": std}
+        plot_fitness_comparison(
+            {k: [[h["best"] for h in e["history"]] for e in v] for k, v in groups.items() if v},
+            out / "hexapod-check.png",
+            title="hexapod: highest fitness so far",
         )
     text = "\n".join(lines) + "\n"
     atomic_write_text(out / "hexapod-check.md", text)
