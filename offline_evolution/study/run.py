@@ -1,0 +1,307 @@
+"""One run of a study: ordinary ``evorbc-evolve`` commands in the run's own folder.
+
+A run folder (``RESULTS/<setting>/seed-NNN/``) holds, when the run is finished:
+
+* ``repertoire.json.xz`` (EvoRBC runs): the ``evorbc-evolve repertoire`` file;
+* ``arbitrator.json.xz``: the ``evorbc-evolve arbitrator`` or ``standard`` file, with the
+  per-generation fitness history;
+* ``run.json``: the run's settings and seed, the commands, the measured cost (wall and CPU
+  seconds, host, threads) and a summary. It is written last, atomically: a run is finished
+  exactly when it exists, and the folder is the single record of the run.
+
+While a run is under way the folder holds the commands' own checkpoints
+(``*.checkpoint.*``); running the same run again resumes from them, so a run killed at any
+point loses at most the work since its last checkpoint and then gives the same files as a
+run that was never interrupted (the commands are seeded and resume bit for bit).
+Finished files are compressed with xz (a 4ws-5 arbitrator file shrinks from 270 kB to
+about 30 kB), so that finished studies stay small enough to keep in the repository.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import json
+import lzma
+import os
+import platform
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from evorbc_ros.atomic_io import atomic_write
+from offline_evolution.study.spec import Run
+
+RUN_FILE = "run.json"
+FORMAT = "evorbc-study-run"
+VERSION = 1
+#: Exit status of ``evorbc-evolve`` after Ctrl-C/SIGTERM: the checkpoint is saved.
+EXIT_INTERRUPTED = 130
+
+
+class RunError(Exception):
+    """A run failed; the message names the run and the command's last output line."""
+
+
+class RunInterrupted(Exception):
+    """A run was stopped by a signal; its checkpoint holds the finished work."""
+
+
+@dataclass(frozen=True)
+class RunRecord:
+    """What a finished run's ``run.json`` says (the parts the runner uses)."""
+
+    path: Path
+    settings: dict
+    seconds: float  # wall time of this run's commands, summed over resumes
+    cpu_seconds: float
+    summary: dict
+
+    @classmethod
+    def load(cls, folder: Path) -> RunRecord:
+        """Read ``folder/run.json``."""
+        data = json.loads((folder / RUN_FILE).read_text(encoding="utf-8"))
+        if data.get("format") != FORMAT:
+            raise RunError(f"{folder / RUN_FILE}: not a study run file")
+        return cls(folder, data["settings"], data["seconds"], data["cpu_seconds"], data["summary"])
+
+
+def is_finished(folder: Path) -> bool:
+    """True when the run in ``folder`` has its ``run.json``."""
+    return (folder / RUN_FILE).is_file()
+
+
+def check_settings(run: Run, folder: Path) -> None:
+    """Refuse a finished run made with other settings (another protocol, an edited file).
+
+    Raises:
+        RunError: naming the folder and the first setting that differs.
+    """
+    record = RunRecord.load(folder)
+    wanted = run.recorded_settings()
+    if record.settings != wanted:
+        key = next(
+            k
+            for k in sorted(set(record.settings) | set(wanted))
+            if record.settings.get(k) != wanted.get(k)
+        )
+        raise RunError(
+            f"{folder}: was run with {key} = {record.settings.get(key)!r}, not "
+            f"{wanted.get(key)!r}; use another results folder for another protocol"
+        )
+
+
+def commands(run: Run, folder: Path) -> list[list[str]]:
+    """The ``evorbc-evolve`` command lines of ``run`` (relative to ``folder``).
+
+    Only the keys the setting names are passed; everything else comes from the robot's
+    shipped settings files (Table I), as for any run started by hand.
+    """
+    v = run.values
+    cli = [sys.executable, "-m", "offline_evolution.cli"]
+    seed = ["--seed", str(run.seed)]
+    out = []
+    if run.approach == "evorbc":
+        rep = [*cli, "repertoire", "--robot", v["robot"], *seed, "--out", "repertoire.json"]
+        for key in ("metric", "bin_size", "eval_time", "initial_batch", "batch_size"):
+            if key in v:
+                rep += [f"--{key.replace('_', '-')}", str(v[key])]
+        for key in ("iterations", "archive", "variation"):
+            if key in v:
+                rep += [f"--{key}", str(v[key])]
+        out.append([*rep, "--quiet"])
+        arb = [*cli, "arbitrator", "--repertoire", "repertoire.json", *seed]
+        if "mapping" in v:
+            arb += ["--mapping", v["mapping"]]
+    else:
+        arb = [*cli, "standard", "--robot", v["robot"], *seed]
+        if v.get("equal_budget"):
+            arb.append("--equal-budget")
+    if "generations" in v:
+        arb += ["--generations", str(v["generations"])]
+    # The fitness curve goes to a scratch name that is removed once the run is finished:
+    # the study report draws its own figures from the histories.
+    out.append([*arb, "--out", "arbitrator.json", "--plot", "fitness-curve.png", "--quiet"])
+    return out
+
+
+def _die_with_parent() -> None:
+    """Child pre-exec hook: get SIGKILL when the runner dies (Linux prctl).
+
+    A run lost with its runner (a killed worker, a lost cluster node) must not keep
+    writing its checkpoint while the retried run resumes from it.
+    """
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+
+
+def _xz(src: Path) -> Path:
+    """Compress ``src`` to ``src.xz`` atomically and remove ``src``."""
+    dest = src.with_name(src.name + ".xz")
+    data = lzma.compress(src.read_bytes(), preset=9 | lzma.PRESET_EXTREME)
+    atomic_write(dest, lambda f: f.write(data), binary=True)
+    src.unlink()
+    return dest
+
+
+def read_json_xz(path: Path) -> dict:
+    """A compressed (``.xz``) or plain JSON file."""
+    raw = path.read_bytes()
+    if path.suffix == ".xz":
+        raw = lzma.decompress(raw)
+    return json.loads(raw)
+
+
+def _summary(folder: Path) -> dict:
+    arb = read_json_xz(folder / "arbitrator.json.xz")
+    evo = arb.get("evolution", {})
+    out = {
+        "best_fitness": evo.get("best_fitness"),
+        "best_generation": evo.get("best_generation"),
+        "generations": len(evo.get("history", [])),
+    }
+    post = evo.get("post_evaluation") or {}
+    if post:
+        out["post_fitness"] = post.get("fitness")
+        out["post_reached"] = post.get("reached")
+    rep_file = folder / "repertoire.json.xz"
+    if rep_file.exists():
+        rep = read_json_xz(rep_file)
+        out["repertoire"] = rep.get("summary", {})
+    return out
+
+
+#: Commands running now (all threads), so that a stop request reaches every one.
+_LIVE: set[subprocess.Popen] = set()
+_LIVE_LOCK = threading.Lock()
+
+
+def interrupt_all() -> None:
+    """Ask every running command to checkpoint and stop (SIGINT, as Ctrl-C would)."""
+    with _LIVE_LOCK:
+        for proc in _LIVE:
+            with contextlib.suppress(ProcessLookupError):
+                proc.send_signal(signal.SIGINT)
+
+
+def execute(run: Run, results: Path, threads: int = 1) -> RunRecord:
+    """Run (or resume, or finish) ``run`` in its folder under ``results``.
+
+    The commands' output goes to ``run.log`` in the run's folder.
+
+    Args:
+        threads: numba threads per command (``NUMBA_NUM_THREADS``); results do not depend
+            on it.
+
+    Raises:
+        RunInterrupted: a command was stopped by a signal (its checkpoint is kept).
+        RunError: a command failed.
+    """
+    folder = results / run.path
+    if is_finished(folder):
+        check_settings(run, folder)
+        return RunRecord.load(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    env = dict(os.environ, NUMBA_NUM_THREADS=str(threads), PYTHONUNBUFFERED="1")
+    with open(folder / "run.log", "a", encoding="utf-8") as log:
+        for cmd in commands(run, folder):
+            target = folder / cmd[cmd.index("--out") + 1]
+            if target.exists() or target.with_name(target.name + ".xz").exists():
+                continue  # finished by an earlier attempt
+            log.write(f"$ evorbc-evolve {' '.join(cmd[3:])}\n")
+            log.flush()
+            status = _run_command(cmd, folder, env, log)
+            if status == EXIT_INTERRUPTED or status < 0:
+                raise RunInterrupted(str(run.path))
+            if status != 0:
+                raise RunError(f"{run.path}: {cmd[3]} failed (status {status}): {_tail(folder)}")
+    for name in ("repertoire.json", "arbitrator.json"):
+        if (folder / name).exists():
+            _xz(folder / name)
+    (folder / "fitness-curve.png").unlink(missing_ok=True)
+    wall, cpu = _spent(folder)
+    record = {
+        "format": FORMAT,
+        "version": VERSION,
+        "settings": run.recorded_settings(),
+        "commands": [" ".join(["evorbc-evolve", *c[3:]]) for c in commands(run, folder)],
+        "seconds": round(wall, 3),
+        "cpu_seconds": round(cpu, 3),
+        "threads": threads,
+        "host": platform.node(),
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores",
+        "finished": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        "summary": _summary(folder),
+    }
+    text = json.dumps(record, indent=1, sort_keys=True) + "\n"
+    atomic_write(folder / RUN_FILE, lambda f: f.write(text))
+    (folder / SPENT_FILE).unlink(missing_ok=True)
+    return RunRecord.load(folder)
+
+
+def _run_command(cmd: list[str], folder: Path, env: dict, log) -> int:
+    """Run one command to its end; add its wall and CPU time to the run's tally.
+
+    Returns:
+        The exit status (negative: killed by that signal).
+    """
+    start = time.monotonic()
+    proc = subprocess.Popen(
+        cmd,
+        cwd=folder,
+        env=env,
+        stdout=log,
+        stderr=subprocess.STDOUT,
+        preexec_fn=_die_with_parent,
+        # Its own session: a terminal's Ctrl-C reaches only the runner, which forwards one
+        # SIGINT (a second one would make the command abort without saving).
+        start_new_session=True,
+    )
+    with _LIVE_LOCK:
+        _LIVE.add(proc)
+    try:
+        # wait4 gives this child's own CPU time (RUSAGE_CHILDREN would mix the runs of
+        # other threads).
+        _, status, usage = os.wait4(proc.pid, 0)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+    finally:
+        with _LIVE_LOCK:
+            _LIVE.discard(proc)
+    wall, cpu = _spent(folder)
+    wall += time.monotonic() - start
+    cpu += usage.ru_utime + usage.ru_stime
+    text = json.dumps({"seconds": wall, "cpu_seconds": cpu})
+    atomic_write(folder / SPENT_FILE, lambda f: f.write(text))
+    return proc.returncode
+
+
+#: Wall and CPU seconds of an unfinished run's earlier attempts.
+SPENT_FILE = ".spent.json"
+
+
+def _spent(folder: Path) -> tuple[float, float]:
+    """Wall and CPU seconds spent on the run so far (``.spent.json``)."""
+    try:
+        data = json.loads((folder / SPENT_FILE).read_text())
+        return float(data["seconds"]), float(data["cpu_seconds"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return 0.0, 0.0
+
+
+def _tail(folder: Path) -> str:
+    try:
+        lines = (folder / "run.log").read_text(encoding="utf-8").strip().splitlines()
+    except OSError:
+        return "see run.log"
+    return lines[-1] if lines else "no output"
+
+
+def remove_partial(folder: Path) -> None:
+    """Delete an unfinished run's folder (``--restart`` of a study run)."""
+    if folder.exists() and not is_finished(folder):
+        shutil.rmtree(folder)
