@@ -265,9 +265,16 @@ def _run_command(cmd: list[str], folder: Path, env: dict, log) -> int:
     with _LIVE_LOCK:
         _LIVE.add(proc)
     try:
-        # wait4 gives this child's own CPU time (RUSAGE_CHILDREN would mix the runs of
-        # other threads).
-        _, status, usage = os.wait4(proc.pid, 0)
+        while True:
+            try:
+                # wait4 gives this child's own CPU time (RUSAGE_CHILDREN would mix the
+                # runs of other threads).
+                _, status, usage = os.wait4(proc.pid, 0)
+                break
+            except KeyboardInterrupt:
+                # Stopped in this thread (a cancelled Ray task): ask the command to save
+                # its checkpoint, and wait for it.
+                proc.send_signal(signal.SIGINT)
         proc.returncode = os.waitstatus_to_exitcode(status)
     finally:
         with _LIVE_LOCK:
