@@ -161,3 +161,22 @@ def test_the_study_file_is_checked_before_anything_runs(tmp_path):
     assert result.returncode == 1
     assert f"{path}: grid.metric: 'round' is not one of circular" in result.stderr
     assert not (tmp_path / "r").exists()
+
+
+def test_the_report_comes_from_the_results_folder_alone(serial_results, tmp_path):
+    out = tmp_path / "report"
+    result = run_study(
+        "report", serial_results.parent / "tiny.yaml", "--results", serial_results, "--out", out
+    )
+    assert result.returncode == 0, result.stderr
+    text = (out / "tiny.md").read_text()
+    assert "* Runs finished: 2, 2-2 seeds per setting (the full protocol has 2)." in text
+    assert "* NEAT generations per run: 12" in text
+    record = json.loads((serial_results / "approach-evorbc" / "seed-001" / "run.json").read_text())
+    best = [record["summary"]["best_fitness"]]
+    record2 = json.loads((serial_results / "approach-evorbc" / "seed-002" / "run.json").read_text())
+    best.append(record2["summary"]["best_fitness"])
+    assert f"| evorbc | 2 | {sum(best) / 2:.3f} ± " in text
+    for name in ("tiny-fitness.png", "tiny-boxplot.png", "tiny-repertoires.png"):
+        assert (out / name).stat().st_size > 10_000
+        assert f"]({name})" in text

@@ -88,10 +88,22 @@ def build_parser() -> argparse.ArgumentParser:
                 default=3,
                 help="Ray: times a run lost with its node is retried from its checkpoint (3)",
             )
+    rep = sub.add_parser("report", help="figures, statistics and verdicts as Markdown")
+    _study_options(rep, protocol=False)
+    rep.add_argument(
+        "--out", metavar="DIR", help="folder for STUDY.md and its figures (default: docs/study)"
+    )
+    rep.add_argument(
+        "--replay-runs",
+        type=_positive_int,
+        metavar="N",
+        help="replay at most N runs per setting for the selection heatmaps (default: all)",
+    )
+    rep.set_defaults(func=cmd_report)
     return p
 
 
-def _study_options(p: argparse.ArgumentParser) -> None:
+def _study_options(p: argparse.ArgumentParser, protocol: bool = True) -> None:
     p.add_argument("study", help="a shipped study (evorbc-study list) or a study file (.yaml)")
     p.add_argument(
         "--results",
@@ -99,6 +111,8 @@ def _study_options(p: argparse.ArgumentParser) -> None:
         metavar="DIR",
         help="results folder: one folder per run, the single record of the study",
     )
+    if not protocol:
+        return
     p.add_argument(
         "--seeds",
         type=_positive_int,
@@ -234,6 +248,24 @@ def cmd_run(args) -> int:
             signal.signal(signal.SIGTERM, previous)
     progress.print("study finished" if not failed else f"{failed} runs failed (see run.log)")
     return EXIT_ERROR if failed else 0
+
+
+def cmd_report(args) -> int:
+    """Write the study's report from its results folder."""
+    from offline_evolution.study.report import default_out, write_report
+    from offline_evolution.study.spec import load_study
+
+    study = load_study(args.study)
+    results = Path(args.results)
+    if not results.is_dir():
+        raise StudyError(f"--results {results}: no such folder")
+    out = Path(args.out) if args.out else default_out()
+    try:
+        md = write_report(study, results, out, args.replay_runs)
+    except ValueError as e:
+        raise StudyError(str(e)) from None
+    print(f"{study.name}: report {md}")
+    return 0
 
 
 def main(argv: Sequence[str] | None = None) -> int:

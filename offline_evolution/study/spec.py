@@ -39,7 +39,9 @@ REPERTOIRE_KEYS = (
 ARBITRATOR_KEYS = ("mapping", "generations")
 STANDARD_KEYS = ("generations", "equal_budget")
 SETTING_KEYS = ("approach", "robot", *REPERTOIRE_KEYS, *ARBITRATOR_KEYS, "equal_budget")
-TOP_KEYS = {"study", "title", "paper", "seeds", "grid", "fixed", "exclude", "compare", "notes"}
+TOP_KEYS = {"study", "title", "paper", "seeds", "grid", "fixed", "exclude", "compare", "figures"}
+#: Figures ``evorbc-study report`` can draw (see :mod:`offline_evolution.study.figures`).
+FIGURES = ("curves", "boxplots", "repertoires", "heatmaps", "selection")
 
 
 @dataclass(frozen=True)
@@ -84,6 +86,7 @@ class Study:
     exclude: list[dict[str, Any]]
     compare: list[dict[str, Any]]
     source: str
+    figures: tuple[str, ...] = ()
 
     def settings(self) -> list[tuple[str, dict[str, Any]]]:
         """``(setting_id, values)`` of every grid combination that is not excluded."""
@@ -210,6 +213,9 @@ def parse_study(data: dict, source: str) -> Study:
     compare = data.get("compare", []) or []
     if not isinstance(compare, list) or not all(isinstance(c, dict) for c in compare):
         raise ConfigError(f"{source}: compare must be a list of mappings")
+    figs = data.get("figures", []) or []
+    if not isinstance(figs, list) or any(f not in FIGURES for f in figs):
+        raise ConfigError(f"{source}: figures must be a list of {', '.join(FIGURES)}")
     study = Study(
         name=name,
         title=str(data.get("title", name)),
@@ -220,6 +226,7 @@ def parse_study(data: dict, source: str) -> Study:
         exclude=exclude,
         compare=compare,
         source=source,
+        figures=tuple(figs),
     )
     if not study.settings():
         raise ConfigError(f"{source}: exclude leaves no setting to run")

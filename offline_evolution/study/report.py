@@ -1,0 +1,305 @@
+"""``evorbc-study report``: a study's figures, statistics and verdicts, as Markdown.
+
+Everything comes from the results folder (the runs' ``run.json`` and files), so a report
+can be regenerated at any time, also while a study is still running (it then says how
+many runs each setting has so far).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import statistics
+from pathlib import Path
+
+import numpy as np
+
+from evorbc_ros.atomic_io import atomic_write
+from offline_evolution.study import figures
+from offline_evolution.study.results import SettingResults, load_results, protocol
+from offline_evolution.study.spec import Study
+from offline_evolution.study.stats import ALPHA, ClaimResult, evaluate_claims
+
+#: Figures a study draws unless its file lists others (``figures:``).
+DEFAULT_FIGURES = ("curves", "boxplots", "repertoires")
+#: Cluster shapes for the projected cost of the full protocol: (machines, cores each).
+CLUSTERS = ((1, 2), (4, 16), (16, 32))
+
+
+def write_report(study: Study, results: Path, out: Path, replay_runs: int | None = None) -> Path:
+    """Draw the study's figures into ``out`` and write ``out/<study>.md``.
+
+    Args:
+        replay_runs: at most this many runs per setting are replayed for the selection
+            heatmaps (default: all).
+
+    Returns:
+        The Markdown file.
+    """
+    settings = load_results(study, results)
+    if not any(s.runs for s in settings):
+        raise ValueError(f"{results}: no finished run of study {study.name}")
+    out.mkdir(parents=True, exist_ok=True)
+    keys = list(study.grid)
+    samples = [(s.values, s.best) for s in settings if s.runs]
+    claims = evaluate_claims(study.compare, samples)
+    drawn = _draw(study, settings, keys, out, replay_runs)
+    text = _markdown(study, settings, keys, claims, drawn, results, out)
+    md = out / f"{study.name}.md"
+    atomic_write(md, lambda f: f.write(text))
+    return md
+
+
+def _draw(study: Study, settings, keys, out: Path, replay_runs) -> list[tuple[str, str]]:
+    """Draw the figures; returns ``(caption, file name)`` pairs."""
+    from offline_evolution.arbitrator.evolve import EQUAL_BUDGET_GENERATIONS
+
+    wanted = study.figures or DEFAULT_FIGURES
+    drawn = []
+    name = study.name
+    if "curves" in wanted:
+        panel, lines = _curve_layout(keys)
+        shift = None
+        if "approach" in keys:
+            robots = {s.values.get("robot") for s in settings}
+            family = "hexapod" if robots == {"hexapod"} else "4ws"
+            shift = {"evorbc": EQUAL_BUDGET_GENERATIONS[family]}
+        path = out / f"{name}-fitness.png"
+        figures.fitness_curves(settings, panel, lines, path, shift, study.title)
+        what = "Highest fitness so far, mean over runs with the min-max band"
+        if shift:
+            what += (
+                f"; EvoRBC's curves start after the {shift['evorbc']} generations its repertoire "
+                "cost (equal budget)"
+            )
+        drawn.append((what + ".", path.name))
+    if "boxplots" in wanted:
+        path = out / f"{name}-boxplot.png"
+        figures.boxplots(settings, keys, path, study.title)
+        drawn.append(
+            ("Each run's highest fitness (boxes: quartiles, whiskers: 1.5 IQR).", path.name)
+        )
+    if "repertoires" in wanted and any(
+        s.values.get("approach", "evorbc") == "evorbc" for s in settings
+    ):
+        path = out / f"{name}-repertoires.png"
+        grid = ("eval_time", "bin_size") if {"eval_time", "bin_size"} <= set(keys) else None
+        evorbc = [s for s in settings if s.values.get("approach", "evorbc") == "evorbc"]
+        figures.example_repertoires(evorbc, [k for k in keys if k != "approach"], path, grid)
+        drawn.append(("An example repertoire per setting (each setting's first seed).", path.name))
+    if "heatmaps" in wanted:
+        path = out / f"{name}-heatmaps.png"
+        figures.bin_time_heatmaps(settings, path)
+        drawn.append(
+            (
+                "Mean repertoire size and mean highest fitness per bin size and evaluation time.",
+                path.name,
+            )
+        )
+    if "selection" in wanted:
+        from offline_evolution.study.selection import aggregate_selection
+
+        panels = []
+        for s in settings:
+            if s.runs and s.values.get("approach", "evorbc") == "evorbc":
+                label = figures.setting_label(s.values, [k for k in keys if k != "approach"])
+                panels.append(
+                    (label or s.values.get("robot", ""), *aggregate_selection(s.runs[:replay_runs]))
+                )
+        if panels:
+            path = out / f"{name}-selection.png"
+            figures.selection_heatmaps(panels, path)
+            drawn.append(
+                (
+                    "Mapping outputs (top) and the displacement of the chosen primitives "
+                    "(bottom) of every run's written controller, from each maze's nominal "
+                    "start, aggregated over the runs.",
+                    path.name,
+                )
+            )
+    return drawn
+
+
+def _curve_layout(keys: list[str]) -> tuple[str | None, list[str]]:
+    """Panels by one key and curves by the other, or one panel with a curve per setting."""
+    if len(keys) == 2:
+        if "approach" in keys:
+            other = next(k for k in keys if k != "approach")
+            return other, ["approach"]
+        return keys[1], [keys[0]]
+    return None, keys
+
+
+def _fmt(x: float, digits: int = 3) -> str:
+    return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{digits}f}"
+
+
+def _p(p: float) -> str:
+    if p is None or math.isnan(p):
+        return "n/a"
+    return "< 0.001" if p < 0.001 else f"{p:.3f}"
+
+
+def _markdown(study, settings: list[SettingResults], keys, claims, drawn, results, out) -> str:
+    proto = protocol(settings)
+    gens = ", ".join(map(str, proto["generations"])) or "n/a"
+    lines = [
+        f"# Study: {study.title}",
+        "",
+        f"The paper's {study.paper}, rerun with `evorbc-study`. This page is written by "
+        f"`evorbc-study report {study.name} --results {results} --out {out}` from the "
+        "results folder alone; rerun it to update it.",
+        "",
+        "## Protocol",
+        "",
+        f"* Settings: {len(settings)} ({', '.join(keys)} over the grid of "
+        f"[config/studies/{Path(study.source).name}](../../config/studies/{Path(study.source).name})).",
+        f"* Runs finished: {proto['runs']}, {proto['min_seeds']}-{proto['max_seeds']} seeds "
+        f"per setting (the full protocol has {study.seeds}).",
+        f"* NEAT generations per run: {gens} (Table I: the study file's).",
+        "* Each run: its own repertoire (EvoRBC) and arbitrator, or a standard-NEAT "
+        "controller, seeded by the run's seed; the figure is the run's highest training "
+        "fitness (eq. 5, mean over the five mazes; 1 or more: every target reached).",
+        "",
+        "## Results per setting",
+        "",
+    ]
+    header = [*keys, "runs", "highest fitness (mean ± sd)", "median", "min-max", "post-eval."]
+    has_rep = any(s.values.get("approach", "evorbc") == "evorbc" for s in settings)
+    if has_rep:
+        header += ["primitives (mean ± sd)", "mean quality"]
+    lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for s in settings:
+        row = [figures.setting_label(s.values, [k]) for k in keys]
+        if not s.runs:
+            lines.append(
+                "| " + " | ".join([*row, "0"] + ["" for _ in header[len(row) + 1 :]]) + " |"
+            )
+            continue
+        b = s.best
+        sd = float(np.std(b, ddof=1)) if len(b) > 1 else math.nan
+        row += [
+            str(len(b)),
+            f"{_fmt(b.mean())} ± {_fmt(sd)}",
+            _fmt(float(np.median(b))),
+            f"{_fmt(b.min())}-{_fmt(b.max())}",
+            _fmt(float(np.nanmean(s.summary("post_fitness")))),
+        ]
+        if has_rep:
+            count = s.summary("repertoire.count")
+            if np.all(np.isnan(count)):
+                row += ["", ""]
+            else:
+                sdc = float(np.nanstd(count, ddof=1)) if len(count) > 1 else math.nan
+                row += [
+                    f"{np.nanmean(count):.0f} ± {_fmt(sdc, 0)}",
+                    _fmt(float(np.nanmean(s.summary("repertoire.mean_quality")))),
+                ]
+        lines.append("| " + " | ".join(row) + " |")
+    lines += [
+        "",
+        "*post-eval.*: the written controller's mean fitness over each maze's nominal start "
+        "and seeded random starts (the run's post-evaluation).",
+        "",
+        "## The paper's claims",
+        "",
+        f"Two-sided Mann-Whitney U tests and Kruskal-Wallis tests (scipy), p-values adjusted "
+        f"with Holm-Bonferroni within each family of comparisons, significance at "
+        f"{ALPHA}. Effect sizes: Vargha-Delaney A12 (the chance that a run of the first "
+        "setting beats one of the second; 0.5 = no effect), epsilon-squared, Pearson's r. "
+        "A claim of *no difference* holds when no test finds one; with few runs that is "
+        "weak evidence, as the verdicts say.",
+        "",
+    ]
+    lines += _claims_table(claims)
+    lines += ["", "## Figures", ""]
+    for caption, name in drawn:
+        lines += [f"![{caption}]({name})", "", caption, ""]
+    lines += _costs(study, settings)
+    return "\n".join(lines) + "\n"
+
+
+def _claims_table(claims: list[ClaimResult]) -> list[str]:
+    out = [
+        "| claim | paper | comparison | means | p | adjusted p | effect | verdict |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for c in claims:
+        for k, comp in enumerate(c.comparisons):
+            means = " vs ".join(_fmt(m) for m in comp.means)
+            effect = f"{comp.effect_name} {_fmt(comp.effect, 2)}" if comp.effect_name else ""
+            if comp.note:
+                effect = f"{effect}; {comp.note}" if effect else comp.note
+            first = k == 0
+            out.append(
+                "| "
+                + " | ".join(
+                    [
+                        c.claim if first else "",
+                        c.paper if first else "",
+                        f"{comp.label} (n = {', '.join(map(str, comp.sizes))})",
+                        means,
+                        _p(comp.p),
+                        _p(comp.p_adjusted),
+                        effect,
+                        f"**{c.verdict}**" if first else "",
+                    ]
+                )
+                + " |"
+            )
+    return out
+
+
+def _costs(study: Study, settings: list[SettingResults]) -> list[str]:
+    """Measured cost per run and the projected cost of the full protocol."""
+    out = ["## Cost", ""]
+    rows, full_cpu = [], 0.0
+    for s in settings:
+        if not s.runs:
+            continue
+        wall = statistics.median(r.record["seconds"] for r in s.runs)
+        cpu = statistics.median(r.record["cpu_seconds"] for r in s.runs)
+        gens = s.runs[0].record["settings"].get("generations")
+        scale = _full_cpu(s, {**s.runs[0].record, "cpu_seconds": 1.0})
+        full_cpu += cpu * scale * study.seeds
+        machine = s.runs[0].record.get("machine", "")
+        rows.append(
+            f"| {figures.setting_label(s.values, list(study.grid))} | {wall / 60:.1f} | "
+            f"{cpu / 60:.1f} | {gens} | {cpu * scale / 60:.1f} | {machine} |"
+        )
+    out += [
+        "Measured per run (median over the setting's runs; one numba thread per run, two runs "
+        "at once on a 2-core VM shared with other work, so wall times are upper bounds). "
+        "The full-protocol column scales the CPU time by the generations of the full "
+        "protocol (the repertoire is a few seconds of it).",
+        "",
+        "| setting | wall min/run | CPU min/run | generations | CPU min/run, full | machine |",
+        "|---|---|---|---|---|---|",
+        *rows,
+        "",
+        f"The full protocol ({study.seeds} seeds per setting) is about {full_cpu / 3600:.0f} "
+        "CPU hours. Runs are independent and take one core each, so on a cluster of N "
+        "machines with M cores it takes about that divided by N x M (plus the longest single "
+        "run):",
+        "",
+        "| machines x cores | wall time |",
+        "|---|---|",
+    ]
+    longest = max((_full_cpu(s, r.record) for s in settings for r in s.runs), default=0.0)
+    for n, m in CLUSTERS:
+        hours = max(full_cpu / (n * m), longest) / 3600
+        out.append(f"| {n} x {m} | {hours:.1f} h |")
+    return [*out, ""]
+
+
+def _full_cpu(setting: SettingResults, record: dict) -> float:
+    """A run's CPU seconds scaled to the full protocol's generations (the study file's)."""
+    done = record["settings"].get("generations")
+    full = setting.values.get("generations")
+    return record["cpu_seconds"] * (full / done if done and full else 1.0)
+
+
+def default_out() -> Path:
+    """``docs/study`` of the source tree (or the current folder when installed)."""
+    root = Path(__file__).resolve().parents[2]
+    return root / "docs" / "study" if (root / "docs").is_dir() else Path(os.getcwd())

@@ -1,0 +1,113 @@
+"""The study report's statistics: Holm's adjustment, the tests and the verdicts."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from offline_evolution.study.stats import (
+    FAILS,
+    HOLDS,
+    INCONCLUSIVE,
+    evaluate_claims,
+    holm,
+    kruskal_wallis,
+    mann_whitney,
+)
+
+
+def test_holm_steps_down_and_keeps_the_input_order():
+    # Sorted: 0.005 x 4 = 0.02, 0.01 x 3 = 0.03, 0.03 x 2 = 0.06, 0.04 x 1 -> max(0.06, 0.04).
+    assert holm([0.01, 0.04, 0.03, 0.005]) == pytest.approx([0.03, 0.06, 0.06, 0.02])
+    assert holm([0.5, 0.9]) == pytest.approx([1.0, 1.0])  # capped at 1
+    got = holm([0.2, math.nan, 0.01])
+    assert math.isnan(got[1]) and got[0] == pytest.approx(0.2) and got[2] == pytest.approx(0.02)
+
+
+def test_mann_whitney_is_scipys_two_sided_test_with_a12():
+    a, b = [1.2, 1.3, 1.25, 1.4, 1.1], [0.4, 0.5, 0.45, 1.15, 0.3]
+    p, a12 = mann_whitney(a, b)
+    assert p == pytest.approx(stats.mannwhitneyu(a, b, alternative="two-sided").pvalue)
+    assert a12 == pytest.approx(24 / 25)  # a beats b in 24 of the 25 pairs
+    assert mann_whitney([1.0, 1.0], [1.0, 1.0]) == (1.0, 0.5)
+    assert all(math.isnan(v) for v in mann_whitney([1.0], [2.0, 3.0]))
+
+
+def test_kruskal_wallis_matches_scipy():
+    groups = [[1.0, 1.1, 1.2], [1.3, 1.4, 1.5], [0.2, 0.3, 0.1]]
+    p, eps = kruskal_wallis(groups)
+    h, p_scipy = stats.kruskal(*groups)
+    assert p == pytest.approx(p_scipy) and eps == pytest.approx(h / 8)
+
+
+def _samples():
+    rng = np.random.default_rng(3)
+    return [
+        ({"robot": "a", "approach": "evorbc"}, 1.2 + 0.01 * rng.standard_normal(10)),
+        ({"robot": "a", "approach": "standard"}, 0.5 + 0.01 * rng.standard_normal(10)),
+        ({"robot": "b", "approach": "evorbc"}, 1.2 + 0.01 * rng.standard_normal(10)),
+        ({"robot": "b", "approach": "standard"}, 1.2 + 0.01 * rng.standard_normal(10)),
+    ]
+
+
+@pytest.mark.parametrize(
+    ("a", "b", "expect", "verdict"),
+    [
+        ("a", "a", "greater", HOLDS),  # evorbc clearly above standard on robot a
+        ("a", "a", "same", FAILS),
+        ("b", "b", "same", HOLDS),  # same distribution on robot b
+        ("b", "b", "greater", INCONCLUSIVE),
+        ("a", "a", "less", FAILS),
+        ("a", "a", "not-less", HOLDS),
+    ],
+)
+def test_verdicts_follow_the_adjusted_tests(a, b, expect, verdict):
+    claim = {
+        "claim": "c",
+        "test": "mann-whitney",
+        "a": {"robot": a, "approach": "evorbc"},
+        "b": {"robot": b, "approach": "standard"},
+        "expect": expect,
+    }
+    (result,) = evaluate_claims([claim], _samples())
+    assert result.verdict == verdict
+
+
+def test_a_family_shares_one_holm_adjustment():
+    claims = [
+        {"claim": f"c{r}", "test": "mann-whitney", "family": "f", "expect": "greater",
+         "a": {"robot": r, "approach": "evorbc"}, "b": {"robot": r, "approach": "standard"}}
+        for r in ("a", "b")
+    ]  # fmt: skip
+    results = evaluate_claims(claims, _samples())
+    raw = [r.comparisons[0].p for r in results]
+    assert [r.comparisons[0].p_adjusted for r in results] == pytest.approx(holm(raw))
+
+
+def test_adjacent_pairs_and_best_and_correlation():
+    samples = [
+        ({"bin_size": b, "eval_time": t}, np.full(5, 1.0 + v) + np.arange(5) * 1e-3)
+        for (b, t, v) in [(0.01, 1.0, 0.2), (0.04, 1.0, 0.1), (0.10, 1.0, -0.3), (0.01, 2.0, 0.3),
+                          (0.04, 2.0, 0.4), (0.10, 2.0, 0.0)]
+    ]  # fmt: skip
+    adjacent, best_claim, wrong_best = evaluate_claims(
+        [
+            {"claim": "smaller bins", "test": "mann-whitney", "adjacent": "bin_size",
+             "expect": "not-less"},
+            {"claim": "best", "test": "best", "a": {"bin_size": 0.04, "eval_time": 2.0}},
+            {"claim": "best", "test": "best", "a": {"bin_size": 0.01, "eval_time": 1.0}},
+        ],
+        samples,
+    )  # fmt: skip
+    labels = [c.label for c in adjacent.comparisons]
+    assert labels == [
+        "bin_size 0.01 vs 0.04 at eval_time 1.0",
+        "bin_size 0.04 vs 0.1 at eval_time 1.0",
+        "bin_size 0.01 vs 0.04 at eval_time 2.0",
+        "bin_size 0.04 vs 0.1 at eval_time 2.0",
+    ]
+    assert adjacent.verdict == FAILS  # 1 cm is below 4 cm at 2 s
+    assert best_claim.verdict == HOLDS
+    assert wrong_best.verdict == FAILS
+    assert "eval_time 2.0" in wrong_best.comparisons[0].note
