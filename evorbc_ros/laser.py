@@ -145,6 +145,7 @@ class LaserToRangefinders:
         # Beams measure the rangefinder rays directly only from the body centre.
         self.centred = pose.x == 0.0 and pose.y == 0.0
         self.rays = layout.ray_angles()  # (n, rays) body frame, rad
+        self._ray_cos_sin = (np.cos(self.rays.ravel()), np.sin(self.rays.ravel()))
         half = 0.5 * layout.field_of_view
         # Fields of view as wedges from the centre narrower than 180 deg (cone_nearest).
         cones = [geo.split_wedges(np.array([[a - half, a + half]])) for a in self.axes]
@@ -191,9 +192,7 @@ class LaserToRangefinders:
         beams = self._scan_beams(angle_min, angle_increment, n_beams)
         m, length = self.layout.mount_radius, self.layout.max_range
         dirs = self.rays.ravel()
-        outside = geo.stretch_inside(
-            beams.origin, dirs, beams.outside(), m, np.full(dirs.size, m + length)
-        )
+        outside = geo.stretch_inside(beams.origin, dirs, beams.outside(), m, m + length)
         seen = (1.0 - outside / length).reshape(self.rays.shape)
         seen = np.where(seen > 1.0 - 1e-9, 1.0, np.where(seen < 1e-9, 0.0, seen))
         return self._report(seen.mean(axis=1), seen.max(axis=1) == 0.0)
@@ -346,20 +345,26 @@ class LaserToRangefinders:
         """Distances (m, from the mount points) and blindness, scanner off the centre."""
         beams = self._scan_beams(angle_min, angle_increment, r.size)
         kind, rr = geo.classify(r, range_min, range_max)
-        boundary = geo.build_boundary(beams, kind, rr, beam_tolerance(angle_increment))
         m, length = self.layout.mount_radius, self.layout.max_range
-        dirs = self.rays.ravel()
-        hits = geo.ray_hits(boundary, dirs)  # m from the centre
-        if self._cones.shape[0]:
-            cone = geo.cone_nearest(boundary, self._cones[:, 0], self._cones[:, 1])
+        tolerance = beam_tolerance(angle_increment)
+        boundary = geo.build_boundary(beams, kind, rr, tolerance, reach=m + length)
+        ux, uy = self._ray_cos_sin
+        one_ray = self._cones.shape[0] == 0
+        hits = None
+        if one_ray or boundary.unknown.shape[0]:
+            hits = geo.ray_hits(boundary, ux, uy, m)  # m from the centre
+        if one_ray:
+            rho = hits
+        else:
+            cone = geo.cone_nearest(boundary, self._cones[:, 0], self._cones[:, 1], m)
             rho = np.full(len(self.axes), np.inf)
             np.minimum.at(rho, self._cone_owner, cone)
-        else:
-            rho = hits
-        # A ray is blind if it runs through directions no valid beam covers before it meets
-        # an obstacle; a field of view only if all its rays are.
-        unknown = geo.stretch_inside(
-            beams.origin, dirs, boundary.unknown, m, np.minimum(hits, m + length)
-        )
-        blind = (unknown > geo.EPS).reshape(self.rays.shape).all(axis=1)
+        blind = np.zeros(len(self.axes), dtype=bool)
+        if boundary.unknown.shape[0]:
+            # A ray is blind if no valid beam covers the point it reads: its first hit, or
+            # the end of its range. A field of view is blind only if all its rays are.
+            far = np.minimum(hits, m + length)
+            ends = np.stack([far * ux, far * uy], axis=1)
+            blind = geo.in_wedges(beams.origin, ends, boundary.unknown)
+            blind = blind.reshape(self.rays.shape).all(axis=1)
         return np.maximum(rho - m, 0.0), blind

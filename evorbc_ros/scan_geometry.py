@@ -20,8 +20,11 @@ node rebuilds the scanner's view and casts the rays into it:
   beam are bridged as if they were not there (the gap is joined or split as above).
 
 A ray reads its first crossing with an obstacle piece; a field of view reads the nearest
-obstacle point inside its wedge. A ray that enters an unknown wedge before its first hit
-(and within its range) is blind. Parts of a ray outside the scan's span see nothing.
+obstacle point inside its wedge. A ray is blind when the point it reads (its first hit, or
+the end of its range) lies in an unknown wedge: no valid beam covers it. (A ray that only
+crosses an unknown wedge on its way, as rays from the mount ring do near an off-centre
+scanner, is read like a clean scan's ray crossing the gaps between its beams.) Parts of a
+ray outside the scan's span see nothing.
 
 Everything is vectorised with numpy over beams and pieces; ``bench/bench_laser.py``
 measures it.
@@ -64,6 +67,7 @@ class ScanBeams:
         origin: ``(2,)`` scanner position in the body frame, m.
         index: ``(n,)`` message index of each beam, in counter-clockwise order (beams past a
             full turn, duplicates of the first ones, are left out).
+        in_order: ``index`` is every message index in order (no reordering needed).
         angle, cos, sin: ``(n,)`` beam directions in the body frame, rad, increasing.
         spacing: angle between neighbouring beams, rad (> 0).
         closed: the beams go round the whole circle, so the last neighbours the first.
@@ -72,6 +76,7 @@ class ScanBeams:
 
     origin: np.ndarray
     index: np.ndarray
+    in_order: bool
     angle: np.ndarray
     cos: np.ndarray
     sin: np.ndarray
@@ -102,6 +107,7 @@ class ScanBeams:
         return cls(
             origin=np.array([x, y], dtype=np.float64),
             index=index,
+            in_order=keep == heading.size and angle_increment > 0,
             angle=angle,
             cos=np.cos(angle),
             sin=np.sin(angle),
@@ -123,13 +129,16 @@ class Boundary:
     """The obstacle pieces and unknown wedges of one scan.
 
     Attributes:
-        a, b: ``(p, 2)`` end points of the obstacle pieces, m, body frame.
+        ax, ay, ex, ey: ``(p,)`` obstacle pieces ``a + s e``, ``0 <= s <= 1``: start point
+            and extent, m, body frame.
         unknown: ``(w, 2)`` wedges ``[lo, hi]`` (rad, seen from the scanner, each narrower
             than 90 deg) holding no valid beam within the tolerance.
     """
 
-    a: np.ndarray
-    b: np.ndarray
+    ax: np.ndarray
+    ay: np.ndarray
+    ex: np.ndarray
+    ey: np.ndarray
     unknown: np.ndarray
 
 
@@ -163,124 +172,174 @@ def classify(
     return kind, np.where(kind == TOUCHING, 0.0, r)
 
 
-def build_boundary(beams: ScanBeams, kind: np.ndarray, r: np.ndarray, tolerance: float) -> Boundary:
+def build_boundary(
+    beams: ScanBeams, kind: np.ndarray, r: np.ndarray, tolerance: float, reach: float = math.inf
+) -> Boundary:
     """The obstacle pieces and unknown wedges of a scan.
 
     Args:
         beams: the scan's geometry.
         kind, r: ``(n,)`` message-order beam kinds and ranges from :func:`classify`.
         tolerance: how far (rad) a valid beam's view reaches over invalid neighbours.
+        reach: pieces farther than this from the body centre (m) may be left out; no
+            rangefinder ray reaches them.
     """
-    kind = kind[beams.index]
-    valid = np.flatnonzero(kind != INVALID)
+    if not beams.in_order:
+        kind, r = kind[beams.index], r[beams.index]
+    valid = kind != INVALID
+    all_valid = bool(valid.all())
+    if all_valid:
+        psi, cos, sin = beams.angle, beams.cos, beams.sin
+    else:
+        valid = np.flatnonzero(valid)
+        if valid.size == 0:
+            lo = beams.lo
+            whole = np.array([[lo, lo + 2.0 * math.pi if beams.closed else beams.hi]])
+            empty = np.empty(0)
+            return Boundary(empty, empty, empty, empty, split_wedges(whole))
+        kind, r = kind[valid], r[valid]
+        psi, cos, sin = beams.angle[valid], beams.cos[valid], beams.sin[valid]
     sx, sy = beams.origin
-    if valid.size == 0:
-        everything = [beams.lo, beams.lo + 2.0 * math.pi] if beams.closed else [beams.lo, beams.hi]
-        return Boundary(np.empty((0, 2)), np.empty((0, 2)), split_wedges(np.array([everything])))
-    kind = kind[valid]
-    rv = r[beams.index][valid]
-    psi = beams.angle[valid]
-    px = sx + rv * beams.cos[valid]
-    py = sy + rv * beams.sin[valid]
+    px, py = sx + r * cos, sy + r * sin
     solid = kind != OPEN  # hits and touching: obstacles at their end point
 
-    # Neighbouring valid beams (i, j), counter-clockwise; the gap between them (rad).
-    i = np.arange(valid.size - 1)
-    j = i + 1
-    gap = (valid[j] - valid[i]) * beams.spacing
+    # Neighbouring valid beams (i, j) counter-clockwise, as slices of the arrays closed up
+    # by the first beam when the scan goes round; the gap between them (rad).
     if beams.closed:
-        i = np.append(i, valid.size - 1)
-        j = np.append(j, 0)
-        gap = np.append(gap, 2.0 * math.pi - (valid[-1] - valid[0]) * beams.spacing)
-    bridged = gap <= 2.0 * tolerance + 1e-9
-    near = np.minimum(rv[i], rv[j])
-    apart = np.hypot(px[j] - px[i], py[j] - py[i])
-    # Adaptive breakpoint distance; no surface can be inferred across a gap >= the angle.
-    with np.errstate(divide="ignore", invalid="ignore"):
-        reach = near * np.sin(gap) / np.sin(GRAZING_ANGLE - gap) + 3.0 * RANGE_SIGMA
-    surface = bridged & solid[i] & solid[j] & (gap < GRAZING_ANGLE) & (apart <= reach)
-
-    a = [np.stack([px[i[surface]], py[i[surface]]], axis=1)]
-    b = [np.stack([px[j[surface]], py[j[surface]]], axis=1)]
-    rest = ~surface & ~(bridged & ~solid[i] & ~solid[j])
-    i, j, gap, bridged = i[rest], j[rest], gap[rest], bridged[rest]
-    # Each side keeps its range over its half of the gap, or over the tolerance.
-    half = np.where(bridged, 0.5 * gap, tolerance)
-    ei = psi[i] + half  # end of beam i's piece
-    ej = psi[i] + gap - half  # start of beam j's piece
-    cix, ciy = sx + rv[i] * np.cos(ei), sy + rv[i] * np.sin(ei)
-    cjx, cjy = sx + rv[j] * np.cos(ej), sy + rv[j] * np.sin(ej)
-    for keep, (ax, ay, bx, by) in (
-        (solid[i], (px[i], py[i], cix, ciy)),  # beam i's range held
-        (solid[j], (cjx, cjy, px[j], py[j])),  # beam j's range held
-        (bridged, (cix, ciy, cjx, cjy)),  # the radial shadow edge at mid-gap
-    ):
-        a.append(np.stack([ax[keep], ay[keep]], axis=1))
-        b.append(np.stack([bx[keep], by[keep]], axis=1))
-    unknown = [np.stack([ei[~bridged], ej[~bridged]], axis=1)]
+        px, py, r, solid, psi = (np.append(v, v[0]) for v in (px, py, r, solid, psi))
+    i, j = slice(0, -1), slice(1, None)
+    if all_valid:
+        bridged = True
+        gap = beams.spacing
+        inferable = gap < GRAZING_ANGLE
+        spread = math.sin(gap) / math.sin(GRAZING_ANGLE - gap) if inferable else 0.0
+    else:
+        index = np.append(valid, valid[0] + beams.index.size) if beams.closed else valid
+        gap = np.diff(index) * beams.spacing
+        bridged = gap <= 2.0 * tolerance + 1e-9
+        inferable = bridged & (gap < GRAZING_ANGLE)
+        spread = np.sin(gap) / np.sin(np.where(inferable, GRAZING_ANGLE - gap, 1.0))
+    # Adaptive breakpoint distance (Borges & Aldon): the farthest apart two hits of one
+    # surface can be; no surface is inferred across a gap of the grazing angle or more.
+    ex, ey = px[j] - px[i], py[j] - py[i]
+    joint = np.minimum(r[i], r[j]) * spread + 3.0 * RANGE_SIGMA
+    surface = solid[i] & solid[j] & (ex * ex + ey * ey <= joint * joint) & inferable
+    pieces = [(px[i][surface], py[i][surface], ex[surface], ey[surface])]
+    unknown = []
+    rest = ~surface & (solid[i] | solid[j] | ~bridged)
+    if rest.any():
+        k = np.flatnonzero(rest)
+        gap = np.broadcast_to(gap, rest.shape)[k]
+        bridged = np.broadcast_to(bridged, rest.shape)[k]
+        ri, rj, si, sj = r[k], r[k + 1], solid[k], solid[k + 1]
+        # Each side keeps its range over its half of the gap, or over the tolerance.
+        half = np.where(bridged, 0.5 * gap, tolerance)
+        ei = psi[k] + half  # end of beam i's piece
+        ej = psi[k] + gap - half  # start of beam j's piece
+        cix, ciy = sx + ri * np.cos(ei), sy + ri * np.sin(ei)
+        cjx, cjy = sx + rj * np.cos(ej), sy + rj * np.sin(ej)
+        for keep, x0, y0, x1, y1 in (
+            (si, px[k], py[k], cix, ciy),  # beam i's range held
+            (sj, cjx, cjy, px[k + 1], py[k + 1]),  # beam j's range held
+            (bridged, cix, ciy, cjx, cjy),  # the radial shadow edge at mid-gap
+        ):
+            pieces.append((x0[keep], y0[keep], x1[keep] - x0[keep], y1[keep] - y0[keep]))
+        if not bridged.all():
+            unknown.append(np.stack([ei[~bridged], ej[~bridged]], axis=1))
 
     if not beams.closed:
         # The outer valid beams reach to the span's edges, or over the tolerance.
-        for k, edge, sign in ((0, beams.lo, -1.0), (valid.size - 1, beams.hi, 1.0)):
+        for k, edge, sign in ((0, beams.lo, -1.0), (psi.size - 1, beams.hi, 1.0)):
             held = psi[k] + sign * min(tolerance, abs(psi[k] - edge))
             if solid[k]:
-                a.append(np.array([[px[k], py[k]]]))
-                b.append(np.array([[sx + rv[k] * math.cos(held), sy + rv[k] * math.sin(held)]]))
+                hx, hy = sx + r[k] * math.cos(held), sy + r[k] * math.sin(held)
+                pieces.append(tuple(np.array([v]) for v in (px[k], py[k], hx - px[k], hy - py[k])))
             if abs(psi[k] - edge) > tolerance:
                 unknown.append(np.array([sorted((held, edge))]))
-    return Boundary(np.concatenate(a), np.concatenate(b), split_wedges(np.concatenate(unknown)))
+    if len(pieces) == 1:
+        ax, ay, ex, ey = pieces[0]
+    else:
+        ax, ay, ex, ey = (np.concatenate(parts) for parts in zip(*pieces, strict=True))
+    if math.isfinite(reach):
+        # No point of a piece is nearer the centre than |a| - |e|.
+        near = np.hypot(ax, ay) - np.hypot(ex, ey) <= reach
+        ax, ay, ex, ey = ax[near], ay[near], ex[near], ey[near]
+    unknown = split_wedges(np.concatenate(unknown)) if unknown else np.empty((0, 2))
+    return Boundary(ax, ay, ex, ey, unknown)
 
 
-def ray_hits(boundary: Boundary, directions: np.ndarray) -> np.ndarray:
+def ray_hits(boundary: Boundary, ux: np.ndarray, uy: np.ndarray, start: float) -> np.ndarray:
     """``(r,)`` distance (m) from the body centre to the first obstacle along each ray.
 
     Args:
-        directions: ``(r,)`` ray directions (rad, body frame); rays start at the centre.
+        ux, uy: ``(r,)`` unit ray directions (body frame); rays run from ``start`` m from
+            the centre (the mount ring) outwards.
 
     Returns:
         +inf where a ray meets no obstacle piece.
     """
-    ux, uy = np.cos(directions)[:, None], np.sin(directions)[:, None]
-    ax, ay = boundary.a[:, 0], boundary.a[:, 1]
-    ex, ey = boundary.b[:, 0] - ax, boundary.b[:, 1] - ay
+    b = boundary
+    ux, uy = ux[:, None], uy[:, None]
     # rho * u = a + s * e  =>  rho = (a x e) / (u x e), s = (a x u) / (u x e).
-    den = _cross(ux, uy, ex, ey)
+    den = ux * b.ey - uy * b.ex
     with np.errstate(divide="ignore", invalid="ignore"):
-        rho = _cross(ax, ay, ex, ey) / den
-        s = _cross(ax, ay, ux, uy) / den
-    met = (den != 0.0) & (s >= -EPS) & (s <= 1.0 + EPS) & (rho >= 0.0)
+        rho = (b.ax * b.ey - b.ay * b.ex) / den
+        s = (b.ax * uy - b.ay * ux) / den
+    met = (s >= -EPS) & (s <= 1.0 + EPS) & (rho >= start)  # False where den = 0 (NaN, inf)
     return np.where(met, rho, np.inf).min(axis=1, initial=np.inf)
 
 
-def cone_nearest(boundary: Boundary, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+def cone_nearest(boundary: Boundary, lo: np.ndarray, hi: np.ndarray, start: float) -> np.ndarray:
     """``(c,)`` distance (m) from the body centre to the nearest obstacle in each wedge.
 
     Args:
         lo, hi: ``(c,)`` wedge edges from the body centre, rad; ``0 < hi - lo < pi``.
+        start: the wedges begin this far from the centre (m, the mount ring); obstacles
+            wholly nearer are not seen, and one that crosses it reads ``start``.
 
     Returns:
         +inf where no obstacle piece enters a wedge.
     """
-    ax, ay = boundary.a[:, 0], boundary.a[:, 1]
-    ex, ey = boundary.b[:, 0] - ax, boundary.b[:, 1] - ay
-    s_lo = np.zeros((lo.size, ax.size))
-    s_hi = np.ones((lo.size, ax.size))
+    b = boundary
+    s_lo = np.zeros((lo.size, b.ax.size))
+    s_hi = np.ones((lo.size, b.ax.size))
     # Inside the wedge: left of its lo edge and right of its hi edge; each is a linear
     # condition n.a + s n.e >= 0 on the piece's parameter s.
-    for nx, ny in ((-np.sin(lo), np.cos(lo)), (np.sin(hi), -np.cos(hi))):
-        na = nx[:, None] * ax + ny[:, None] * ay
-        ne = nx[:, None] * ex + ny[:, None] * ey
-        with np.errstate(divide="ignore", invalid="ignore"):
-            bound = -na / ne
-        s_lo = np.where(ne > 0.0, np.maximum(s_lo, bound), s_lo)
-        s_hi = np.where(ne < 0.0, np.minimum(s_hi, bound), s_hi)
-        s_hi = np.where((ne == 0.0) & (na < 0.0), -1.0, s_hi)
-    length2 = ex * ex + ey * ey
     with np.errstate(divide="ignore", invalid="ignore"):
-        foot = np.where(length2 > 0.0, -(ax * ex + ay * ey) / length2, 0.0)
+        for nx, ny in ((-np.sin(lo), np.cos(lo)), (np.sin(hi), -np.cos(hi))):
+            na = nx[:, None] * b.ax + ny[:, None] * b.ay
+            ne = nx[:, None] * b.ex + ny[:, None] * b.ey
+            bound = -na / ne
+            s_lo = np.where(ne > 0.0, np.maximum(s_lo, bound), s_lo)
+            s_hi = np.where(ne < 0.0, np.minimum(s_hi, bound), s_hi)
+            s_hi = np.where((ne == 0.0) & (na < 0.0), -1.0, s_hi)
+        length2 = b.ex * b.ex + b.ey * b.ey
+        foot = np.where(length2 > 0.0, -(b.ax * b.ex + b.ay * b.ey) / length2, 0.0)
     s = np.clip(foot, s_lo, s_hi)
-    rho = np.hypot(ax + s * ex, ay + s * ey)
-    return np.where(s_lo <= s_hi, rho, np.inf).min(axis=1, initial=np.inf)
+    rho = np.hypot(b.ax + s * b.ex, b.ay + s * b.ey)
+    inside = s_lo <= s_hi
+    if start > 0.0:
+        # The distance from the centre is largest at an end of the stretch in the wedge.
+        outer = np.maximum(
+            np.hypot(b.ax + s_lo * b.ex, b.ay + s_lo * b.ey),
+            np.hypot(b.ax + s_hi * b.ex, b.ay + s_hi * b.ey),
+        )
+        inside &= outer >= start
+        rho = np.maximum(rho, start)
+    return np.where(inside, rho, np.inf).min(axis=1, initial=np.inf)
+
+
+def in_wedges(origin: np.ndarray, points: np.ndarray, wedges: np.ndarray) -> np.ndarray:
+    """``(k,)`` True where a point lies strictly inside one of the wedges.
+
+    Args:
+        origin: ``(2,)`` the wedges' apex (the scanner), m, body frame.
+        points: ``(k, 2)`` points, m, body frame.
+        wedges: ``(w, 2)`` wedges ``[lo, hi]`` (rad, seen from ``origin``).
+    """
+    psi = np.arctan2(points[:, 1] - origin[1], points[:, 0] - origin[0])[:, None]
+    into = np.mod(psi - wedges[:, 0], 2.0 * np.pi)
+    return ((into > EPS) & (into < wedges[:, 1] - wedges[:, 0] - EPS)).any(axis=1)
 
 
 def wedge_intervals(
@@ -315,15 +374,13 @@ def wedge_intervals(
 
 
 def stretch_inside(
-    origin: np.ndarray, directions: np.ndarray, wedges: np.ndarray, near: float, far: np.ndarray
+    origin: np.ndarray, directions: np.ndarray, wedges: np.ndarray, near: float, far: float
 ) -> np.ndarray:
-    """``(r,)`` length (m) of each ray's stretch ``[near, far]`` that lies in the wedges.
+    """``(r,)`` length (m) of each ray's stretch inside the wedges.
 
-    The wedges must not overlap. ``far`` is ``(r,)`` (m from the centre).
+    The stretch runs from ``near`` to ``far`` m from the centre; the wedges must not overlap.
     """
     if wedges.shape[0] == 0:
         return np.zeros(directions.size)
     start, end = wedge_intervals(origin, directions, wedges)
-    start = np.maximum(start, near)
-    end = np.minimum(end, np.asarray(far, dtype=np.float64)[:, None])
-    return np.clip(end - start, 0.0, None).sum(axis=1)
+    return np.clip(np.minimum(end, far) - np.maximum(start, near), 0.0, None).sum(axis=1)

@@ -249,11 +249,27 @@ def test_dropouts_with_an_offset_scanner():
         except InputError:
             continue
         used += 1
-        np.testing.assert_allclose(got, clean, atol=0.02)  # walls are bridged straight
+        np.testing.assert_allclose(got, clean, atol=1e-9)  # walls are bridged straight
     assert used >= 198
-    # The 0 deg ray runs from -63 to -5 deg as the scanner sees it: a 20 deg dead sector
-    # at -40 deg (too wide to bridge) blinds it before it meets the wall.
+    # The 0 deg ray runs from -63 deg (its mount point) to -9.5 deg (the wall it meets at
+    # x = 0.6 m) as the scanner sees it. A 20-deg dead sector that it only crosses on its
+    # way changes nothing; one around the point it reads blinds it.
     heading = angle_min + inc * np.arange(360)
     r = np.where(np.abs(heading + 40 * DEG) < 10 * DEG, math.nan, ranges)
+    np.testing.assert_array_equal(converter.readings(angle_min, inc, r, 0.0, RANGE_MAX), clean)
+    r = np.where(np.abs(heading + 9.5 * DEG) < 10 * DEG, math.nan, ranges)
     with pytest.raises(InputError, match=r"rangefinder at 0\.0 deg"):
         converter.readings(angle_min, inc, r, 0.0, RANGE_MAX)
+
+
+def test_touching_the_scanner_blocks_the_rays_that_pass_it():
+    # REP 117: -inf is an object closer than range_min. The scanner sits 0.1 m ahead on the
+    # forward axis; the 0 deg ray, from 0.05 m, passes through it.
+    pose = LaserPose(0.1, 0.0)
+    angle_min, inc, ranges = scan(pose, box(-0.4, -0.5, 0.6, 0.35), 360, RANGE_MAX)
+    converter = LaserToRangefinders(RF, pose)
+    clean = converter.readings(angle_min, inc, ranges, 0.0, RANGE_MAX)
+    ranges[180] = -math.inf  # the beam at 0 deg
+    got = converter.readings(angle_min, inc, ranges, 0.0, RANGE_MAX)
+    assert got[0] == pytest.approx(1 - 0.05, abs=1e-12)  # met at the scanner, 0.05 m out
+    np.testing.assert_array_equal(got[1:], clean[1:])
