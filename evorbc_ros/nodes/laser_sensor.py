@@ -16,7 +16,7 @@ from rclpy.node import Node
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Float64MultiArray
 
-from evorbc_ros.laser import InputError, LaserPose, LaserToRangefinders
+from evorbc_ros.laser import Coverage, InputError, LaserPose, LaserToRangefinders
 from evorbc_ros.nodes.common import (
     RELIABLE,
     SENSOR_DATA,
@@ -74,7 +74,7 @@ class LaserSensorNode(Node):
             self.warn_coverage(topic, self.converter.coverage(*span))
         self.pub.publish(vector_message(readings, self.names))
 
-    def warn_coverage(self, topic: str, cover) -> None:
+    def warn_coverage(self, topic: str, cover: Coverage) -> None:
         """Warn (once per scan span) about rangefinders the scan does not wholly cover."""
         if cover.unseen:
             self.get_logger().warning(
