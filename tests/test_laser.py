@@ -79,8 +79,9 @@ def test_scanner_offset_from_the_body_centre():
     pose = LaserPose(x=0.1)
     beams = np.radians(np.arange(-180.0, 180.0, 0.25))
     readings = convert(beams[0], 0.25 * DEG, room_ranges(beams, pose), pose)
-    # Hit points are re-measured from the centre: still 0.45 m from each mount point.
-    np.testing.assert_allclose(readings, 0.55, atol=2e-3)  # nearest beam, 0.25 deg apart
+    # The circle is rebuilt from chords between neighbouring hits, each within 2 um of it
+    # (0.25 deg apart), and the rays cast from the mount points: 0.45 m from each.
+    np.testing.assert_allclose(readings, 0.55, atol=5e-6)
 
 
 @pytest.mark.parametrize(
@@ -120,11 +121,11 @@ def test_invalid_beams_are_skipped_when_others_cover_the_rangefinder():
     [(180, math.nan, "0.0"), (240, 0.01, "60.0"), (300, math.nan, "120.0")],
 )
 def test_a_rangefinder_whose_beams_are_all_invalid_refuses_the_scan(index, value, axis):
-    # One-ray rangefinders: the beam on the axis is the only one within half a gap. Were
-    # it read as "nothing seen", the robot would walk blind that way.
+    # One-ray rangefinders: beams within 2.5 deg of the axis count (1 deg spacing). With
+    # all five invalid, reading "nothing seen" would let the robot walk blind that way.
     beams = np.radians(np.arange(-180.0, 180.0, 1.0))
     ranges = np.full(beams.size, 0.4)
-    ranges[index] = value
+    ranges[index - 2 : index + 3] = value
     with pytest.raises(InputError, match=f"rangefinder at {axis} deg"):
         convert(beams[0], DEG, ranges, range_min=0.02)
     nan_everywhere = np.full(beams.size, math.nan)

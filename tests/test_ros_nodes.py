@@ -26,6 +26,7 @@ def scan(ranges, angle_min=-math.pi, increment=None):
     msg = LaserScan()
     msg.angle_min = angle_min
     msg.angle_increment = increment if increment is not None else 2 * math.pi / len(ranges)
+    msg.angle_max = angle_min + msg.angle_increment * (len(ranges) - 1)
     msg.range_max = 10.0
     msg.ranges = [float(r) for r in ranges]
     return msg

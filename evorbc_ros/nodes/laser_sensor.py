@@ -2,9 +2,10 @@
 
 Subscribes ``scan`` (LaserScan, sensor-data QoS) and publishes ``evorbc/rangefinders``
 (std_msgs/Float64MultiArray, reliable): one reading in [0, 1] per configured rangefinder,
-labelled with the input names. Malformed scans, and scans whose beams towards a
-rangefinder are all invalid, are logged and skipped (the input goes stale and the robot
-stops).
+labelled with the input names (docs/laser.md). Invalid beams near a rangefinder are
+bridged by the valid beams around them. Malformed scans, scans whose beam count disagrees
+with their angles, and scans that leave a rangefinder with no valid beam are logged and
+skipped (the input goes stale and the robot stops).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from rclpy.node import Node
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Float64MultiArray
 
-from evorbc_ros.laser import InputError, LaserPose, LaserToRangefinders
+from evorbc_ros.laser import Coverage, InputError, LaserPose, LaserToRangefinders
 from evorbc_ros.nodes.common import (
     RELIABLE,
     SENSOR_DATA,
@@ -54,25 +55,38 @@ class LaserSensorNode(Node):
 
     def on_scan(self, msg: LaserScan) -> None:
         """Publish the readings of one scan, or log why it was skipped."""
+        topic = self.sub.topic_name
         try:
             readings = self.converter.readings(
-                msg.angle_min, msg.angle_increment, msg.ranges, msg.range_min, msg.range_max
+                msg.angle_min,
+                msg.angle_increment,
+                msg.ranges,
+                msg.range_min,
+                msg.range_max,
+                angle_max=msg.angle_max,
             )
         except InputError as e:
-            self.get_logger().warning(
-                f"{self.scan_topic}: skipped a scan: {e}", throttle_duration_sec=2.0
-            )
+            self.get_logger().warning(f"{topic}: skipped a scan: {e}", throttle_duration_sec=2.0)
             return
         span = (msg.angle_min, msg.angle_increment, len(msg.ranges))
         if span != self.warned_span:
             self.warned_span = span
-            unseen = self.converter.unseen(*span)
-            if unseen:
-                self.get_logger().warning(
-                    f"{self.scan_topic}: the scan never covers the rangefinders at {unseen} deg "
-                    "(body frame); they read 0, nothing seen"
-                )
+            self.warn_coverage(topic, self.converter.coverage(*span))
         self.pub.publish(vector_message(readings, self.names))
+
+    def warn_coverage(self, topic: str, cover: Coverage) -> None:
+        """Warn (once per scan span) about rangefinders the scan does not wholly cover."""
+        if cover.unseen:
+            self.get_logger().warning(
+                f"{topic}: the scan never covers the rangefinders at {cover.unseen} deg "
+                "(body frame); they read 0, nothing seen"
+            )
+        if cover.partly:
+            parts = ", ".join(f"{a} deg ({s:.0%} covered)" for a, s in cover.partly.items())
+            self.get_logger().warning(
+                f"{topic}: the scan covers only part of the rangefinders at {parts} (body "
+                "frame); walls in the rest are not seen"
+            )
 
 
 def main(argv=None) -> int:
