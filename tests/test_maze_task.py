@@ -1,7 +1,6 @@
 """The maze task kernel: eq. 5 fitness, walls, and agreement with the onboard controller."""
 
 import math
-from dataclasses import replace
 
 import numba
 import numpy as np
