@@ -153,3 +153,37 @@ def test_starts_are_seeded_and_clear_of_walls(five_maze_task):
         assert five_maze_task.mazes[int(k)].clearance(x, y) >= 0.05
     assert not np.array_equal(a, five_maze_task.sample_starts(np.random.default_rng(8)))
     assert math.isclose(a[:, 0].sum(), sum(range(5)))
+
+
+def test_episodes_that_reach_a_fixed_point_end_with_the_full_episodes_outcome(small_repertoire):
+    # A robot whose whole state stops changing (stopped, or pushing straight into a wall)
+    # repeats that cycle forever; the kernel stops it early. Recorded episodes never stop
+    # early, so they give the full episodes' outcome to compare with, bit for bit.
+    task = MazeTask(MazeTaskSettings(("obstacle", "zigzag", "gaps")), "4ws-5")
+    starts = task.sample_starts(np.random.default_rng(11))
+    standard = neat_config(n_outputs=5)
+    evorbc = neat_config(n_outputs=2)
+    cases = [
+        # random networks (most stand still) and two that stand still or hit a wall
+        (
+            [network_spec(g, standard) for g in random_genomes(standard, 40, seed=5)]
+            + [constant_network(-10.0), constant_network(10.0)],
+            standard_controller(task.robot),
+        ),
+        # random arbitrators: primitives keep most robots moving to the last cycle
+        (
+            [network_spec(g, evorbc) for g in random_genomes(evorbc, 40, seed=6)],
+            evorbc_controller(small_repertoire, "polar", task.robot),
+        ),
+    ]
+    moving = settled = 0
+    for networks, controller in cases:
+        fast = task.evaluate(networks, controller, starts)
+        full = task.evaluate(networks, controller, starts, record=True)
+        for field in ("reached", "cycles", "final_distance", "initial_distance", "fitness"):
+            assert np.array_equal(getattr(fast, field), getattr(full, field)), field
+        last_step = np.any(full.pose[:, -1] != full.pose[:, -2], axis=1) & ~full.reached
+        moving += int(last_step.sum())
+        settled += int(np.sum(np.all(full.pose[:, -1] == full.pose[:, -200], axis=1)))
+    # Both kinds of episode were there to compare.
+    assert moving >= 10 and settled >= 10

@@ -118,6 +118,7 @@ def run_episodes(
         values = np.empty(max_slots)
         out = np.empty(n_outputs)
         command = np.empty(5)
+        before = np.empty(STATE_SIZE)
         initial_distance[e] = math.hypot(start[e, 0] - tx, start[e, 1] - ty)
         dist = initial_distance[e]
         for t in range(n_cycles):
@@ -147,12 +148,26 @@ def run_episodes(
                 trace_choice[e, t] = choice
                 for k in range(n_outputs):
                     trace_outputs[e, t, k] = out[k]
+            for k in range(STATE_SIZE):
+                before[k] = state[e, k]
             step_robot(state, e, command, lim, boxes, cand)
             dist = math.hypot(state[e, X] - tx, state[e, Y] - ty)
             if dist <= target_radius[m]:
                 reached[e] = True
                 cycles[e] = t + 1
                 break
+            if not record:
+                # A fixed point: the whole state (pose, speed, wheel angles) came back
+                # unchanged, so every later cycle reads the same sensors, gets the same
+                # outputs from the (stateless, feed-forward) network and makes the same
+                # step. The episode's outcome is already known: stop here.
+                same = True
+                for k in range(STATE_SIZE):
+                    if state[e, k] != before[k]:
+                        same = False
+                        break
+                if same:
+                    break
         final_distance[e] = dist
         if record:
             last = cycles[e]
