@@ -8,6 +8,7 @@ executables, without the ros2 CLI; with it, ``ros2 run`` itself is tried too.
 
 import os
 import py_compile
+import re
 import shutil
 import subprocess
 import sys
@@ -49,6 +50,14 @@ def prefix(tmp_path_factory):
         capture_output=True,
     )
     return out
+
+
+def assert_startup_error(stderr: str, node: str, message: str) -> None:
+    """The node's last line is its logger's one-line start-up error, and no traceback."""
+    assert "Traceback" not in stderr
+    last = stderr.strip().splitlines()[-1]
+    pattern = rf"\[FATAL\] \[[0-9.]+\] \[{node}\]: cannot start: {re.escape(message)}"
+    assert re.fullmatch(pattern, last), last
 
 
 def site_packages(prefix: Path) -> Path:
@@ -117,7 +126,7 @@ def test_an_installed_node_starts_and_reports_bad_files(prefix, tmp_path):
         cwd=tmp_path,
     )
     assert done.returncode == 2, done.stderr
-    assert done.stderr.strip().splitlines()[-1] == f"error: {missing}: no such arbitrator file"
+    assert_startup_error(done.stderr, "arbitrator", f"{missing}: no such arbitrator file")
     # It ran the installed copy, whose settings come from the prefix's share folder.
     script = "from evorbc_ros.config import config_dir; print(config_dir())"
     where = subprocess.run(
