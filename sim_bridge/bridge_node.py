@@ -47,12 +47,14 @@ from evorbc_ros.config import ConfigError
 from evorbc_ros.nodes.common import (
     LATCHED,
     RELIABLE,
+    Executor,
     StartupError,
     declare,
     finite_parameter,
     init_ros,
     logged_startup,
     quiet_teardown,
+    stop_requested,
 )
 from evorbc_ros.robots.hexapod import HEXAPOD
 from sim_bridge.bridge_robots import bridge_robot_class
@@ -315,7 +317,7 @@ class SimBridgeNode(Node):
 
     def run_lockstep(self) -> None:
         """The lockstep loop: state out, both commands in, step."""
-        executor = rclpy.executors.SingleThreadedExecutor()
+        executor = Executor()
         executor.add_node(self)
         try:
             self.wait_for_graph(executor)
@@ -332,7 +334,7 @@ class SimBridgeNode(Node):
 
     def run_realtime(self) -> None:
         """Step every 0.1 s of wall time with whatever commands are current."""
-        executor = rclpy.executors.SingleThreadedExecutor()
+        executor = Executor()
         executor.add_node(self)
         period = self.world.dt
         try:
@@ -395,8 +397,9 @@ def episode_verdict(result: dict) -> str:
 
 def main(argv=None) -> int:
     """Run one episode and exit: 0 when it ran (or was interrupted), 2 if it cannot start."""
-    if not init_ros(argv):
-        return 2
+    status = init_ros(argv)
+    if status is not None:
+        return status
     node, result = None, None
     try:
         node = SimBridgeNode()
@@ -409,7 +412,12 @@ def main(argv=None) -> int:
         if not e.logged:
             print(f"error: {e}", file=sys.stderr)
         return 2
-    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
+    except Exception as e:
+        if not isinstance(e, rclpy.executors.ExternalShutdownException) and not stop_requested():
+            raise
+        if node is not None:  # stopped by a signal, maybe as the context went away
+            result = node.finish(interrupted=True)
+    except KeyboardInterrupt:
         if node is not None:
             result = node.finish(interrupted=True)
     finally:

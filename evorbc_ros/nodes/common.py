@@ -82,36 +82,63 @@ def logged_startup(node: Node) -> Iterator[None]:
         raise
 
 
-def stop_on_first_signal() -> None:
-    """SIGINT or SIGTERM stops the process once (KeyboardInterrupt); later ones are ignored.
+_stopping = False
 
-    Call before ``rclpy.init``: rclpy's own handler (which wakes the executor and shuts
-    the context down) then chains to this one. ``ros2 launch`` run from a script sends a
-    second SIGINT while the nodes shut down; without this, that one raises inside
-    ``destroy_node`` and prints a traceback.
+
+def stop_on_first_signal() -> None:
+    """Make SIGINT and SIGTERM stop the node once; later ones are ignored.
+
+    Call before ``rclpy.init``. rclpy's own handler then chains to this one: on the first
+    signal rclpy shuts the context down and wakes the executor, so ``spin`` and the
+    bridge's loops end by themselves; this handler only notes the stop. Raising
+    KeyboardInterrupt there instead would land anywhere, in a numba compiler callback or
+    in ``destroy_node``, and print a traceback. Only while rclpy's handler is not
+    installed (inside ``rclpy.init``) does the first signal raise KeyboardInterrupt.
+    ``ros2 launch`` run from a script sends a second SIGINT while the nodes shut down:
+    it is ignored.
     """
-    stopping = False
+    from rclpy.signals import SignalHandlerOptions, get_current_signal_handlers_options
 
     def on_signal(signum, frame) -> None:
-        nonlocal stopping
-        if not stopping:
-            stopping = True
-            raise KeyboardInterrupt
+        global _stopping
+        if _stopping:
+            return
+        _stopping = True
+        if get_current_signal_handlers_options() == SignalHandlerOptions.NO:
+            raise KeyboardInterrupt  # rclpy is not listening yet: nothing else would stop
 
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
 
 
-def quiet_teardown() -> None:
-    """Stop rclpy's signal handling before tearing down: no signal thread races the teardown.
+def stop_requested() -> bool:
+    """True once SIGINT or SIGTERM arrived (see :func:`stop_on_first_signal`).
 
-    rclpy's handler thread shuts contexts down and triggers the executors' guard
-    conditions on every signal; a second signal while the node and executor are being
-    destroyed would touch objects being freed.
+    rclpy's signal thread shuts the context down at once, so a node still being built
+    then fails with "context is not valid": that is a stop, not an error.
+    """
+    return _stopping
+
+
+def quiet_teardown() -> None:
+    """Ignore SIGINT and SIGTERM from now on: the process is finishing anyway.
+
+    rclpy's signal thread shuts contexts down and triggers the executors' guard conditions
+    on every signal; a second signal while the node and executor are being destroyed would
+    touch objects being freed, so rclpy's handlers go first. The signals are then ignored
+    at the OS level: Python restores the default action of every signal it handled as it
+    exits, and a late SIGINT would then kill the process (status -2) after a clean stop.
     """
     from rclpy.signals import uninstall_signal_handlers
 
     uninstall_signal_handlers()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    # CPython marks the process as ended by Ctrl-C when a KeyboardInterrupt leaves code run
+    # by exec() of a string (numba and dataclasses compile that way), even once caught,
+    # and then kills itself with SIGINT as it exits (status -2 after a clean stop). Each
+    # such exec() clears the mark first; this one clears it for good.
+    exec("None")
 
 
 def vector_message(values: Sequence[float], names: Sequence[str] = ()) -> Float64MultiArray:
@@ -145,16 +172,36 @@ def now_seconds(node: Node) -> float:
     return node.get_clock().now().nanoseconds * 1e-9
 
 
-def init_ros(argv: Sequence[str] | None) -> bool:
-    """``rclpy.init`` with :func:`stop_on_first_signal`; False (and one line) on bad args."""
+class Executor(rclpy.executors.SingleThreadedExecutor):
+    """rclpy's single-threaded executor, safe to make while a signal stops the process.
+
+    Made just as the signal shuts the context down, its ``__init__`` fails; rclpy's
+    ``__del__`` then reads an attribute that was never set and prints a traceback. The
+    class attribute gives it one.
+    """
+
+    _sigint_gc = None
+
+
+def init_ros(argv: Sequence[str] | None) -> int | None:
+    """``rclpy.init`` after :func:`stop_on_first_signal`.
+
+    Returns:
+        None to go on; otherwise the exit status: 2 after one line on bad arguments, 0 if
+        a signal came first.
+    """
     stop_on_first_signal()
     try:
         rclpy.init(args=argv)
+    except KeyboardInterrupt:
+        quiet_teardown()
+        rclpy.try_shutdown()
+        return 0
     except Exception as e:  # rcl reports bad --ros-args as a generic RCLError
         first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
         print(f"error: cannot start: {first}", file=sys.stderr)
-        return False
-    return True
+        return 2
+    return None
 
 
 def run_node(make: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
@@ -163,18 +210,22 @@ def run_node(make: Callable[[], Node], argv: Sequence[str] | None = None) -> int
     Returns 0 after Ctrl-C or SIGTERM, 2 if the node cannot start (the node has logged
     why; see :func:`logged_startup`).
     """
-    if not init_ros(argv):
-        return 2
+    status = init_ros(argv)
+    if status is not None:
+        return status
     node = None
     try:
         node = make()
-        rclpy.spin(node)
+        rclpy.spin(node, Executor())
     except StartupError as e:
         if not e.logged:
             print(f"error: {e}", file=sys.stderr)
         return 2
     except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
         pass
+    except Exception:
+        if not stop_requested():
+            raise
     finally:
         quiet_teardown()
         if node is not None:
