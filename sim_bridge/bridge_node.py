@@ -57,9 +57,7 @@ from evorbc_ros.nodes.common import (
     stop_requested,
 )
 from evorbc_ros.robots.hexapod import HEXAPOD
-from sim_bridge.bridge_robots import bridge_robot_class
 from sim_bridge.graph import default_maze
-from sim_bridge.maze import load_named_maze
 
 
 def stamp(seconds: float) -> Time:
@@ -129,6 +127,12 @@ class SimBridgeNode(Node):
                 raise StartupError(
                     f"parameter mode must be lockstep or realtime, got {self.mode!r}"
                 )
+            # Imported here, after rclpy.init: numba and PyBullet take seconds to load, and
+            # a graph shut down meanwhile (another node refused to start) would otherwise
+            # interrupt the import with a KeyboardInterrupt traceback.
+            from sim_bridge.bridge_robots import bridge_robot_class
+            from sim_bridge.maze import load_named_maze
+
             try:
                 maze = load_named_maze(maze_name)
             except ConfigError as e:

@@ -147,11 +147,15 @@ def goal_message(cls, x, y):
 
 
 def test_goals_from_a_volatile_publisher_are_taken(ros):
+    logs = ros.listen(Log, "/rosout", ROSOUT)
     node = ros.make(RadarSensorNode)
     pub = ros.publisher(PointStamped, "goal", RELIABLE)  # ros2 topic pub's default QoS
     ros.connected(pub)
     pub.publish(goal_message(PointStamped, 1.0, 2.0))
     assert ros.spin_until(lambda: node.goal == (1.0, 2.0, "odom"))
+    ros.spin_until(lambda: False, timeout=0.2)
+    # Taken without a false alarm from the latched subscription.
+    assert not [m.msg for m in logs if m.name == "radar_sensor" and m.level >= Log.WARN]
 
 
 def test_a_latched_goal_published_before_the_node_started_is_taken(ros):

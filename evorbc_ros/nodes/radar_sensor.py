@@ -19,6 +19,7 @@ import sys
 
 from geometry_msgs.msg import PointStamped, PoseStamped
 from nav_msgs.msg import Odometry
+from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
 from std_msgs.msg import Float64MultiArray
 
@@ -63,9 +64,14 @@ class RadarSensorNode(Node):
         self.goal: tuple[float, float, str] | None = None
         self.pub = self.create_publisher(Float64MultiArray, out_topic, RELIABLE)
         msg_type = PointStamped if goal_type == "point" else PoseStamped
+        # A volatile publisher is "incompatible" with the latched subscription by design;
+        # the volatile one takes its goals, and reports any real mismatch (best effort).
+        quiet = SubscriptionEventCallbacks(incompatible_qos=lambda info: None)
         self.goal_subs = [
-            self.create_subscription(msg_type, self.goal_topic, self.on_goal, qos)
-            for qos in (LATCHED, RELIABLE)
+            self.create_subscription(
+                msg_type, self.goal_topic, self.on_goal, LATCHED, event_callbacks=quiet
+            ),
+            self.create_subscription(msg_type, self.goal_topic, self.on_goal, RELIABLE),
         ]
         self.odom_sub = self.create_subscription(
             Odometry, self.odom_topic, self.on_odom, SENSOR_DATA
