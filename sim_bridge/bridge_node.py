@@ -47,13 +47,17 @@ from evorbc_ros.config import ConfigError
 from evorbc_ros.nodes.common import (
     LATCHED,
     RELIABLE,
+    Executor,
     StartupError,
     declare,
     finite_parameter,
+    init_ros,
+    logged_startup,
+    quiet_teardown,
+    stop_requested,
 )
 from evorbc_ros.robots.hexapod import HEXAPOD
-from sim_bridge.bridge_robots import bridge_robot_class
-from sim_bridge.maze import load_named_maze
+from sim_bridge.graph import default_maze
 
 
 def stamp(seconds: float) -> Time:
@@ -67,59 +71,75 @@ class SimBridgeNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__("sim_bridge", **kwargs)
-        maze_name = declare(self, "maze", "obstacle", "maze name or maze YAML file")
-        robot = declare(self, "robot", "4ws-5", "robot type")
-        self.mode = declare(self, "mode", "lockstep", "lockstep or realtime")
-        gui = declare(self, "gui", False, "open the PyBullet GUI window")
-        start = declare(self, "start", "nominal", "nominal, random, or 'x,y,heading_deg'")
-        seed = declare(self, "seed", 0, "seed of a random start")
-        episode_time = finite_parameter(
-            self,
-            "episode_time",
-            30.0 if robot == HEXAPOD else 120.0,
-            "episode length T (s; default 120, hexapod 30)",
-            positive=True,
-        )
-        self.lockstep_timeout = finite_parameter(
-            self,
-            "lockstep_timeout",
-            30.0,
-            "wall seconds without commands before the state is sent again anyway",
-            positive=True,
-        )
-        self.wait_subscribers = declare(
-            self,
-            "wait_for_subscribers",
-            ["scan", "odom"],
-            "topics that need a subscriber before the run starts",
-        )
-        self.wait_publishers = declare(
-            self,
-            "wait_for_publishers",
-            (
-                ["joint_trajectory_controller/joint_trajectory"]
-                if robot == HEXAPOD
-                else ["steering_position_controller/commands", "wheel_velocity_controller/commands"]
+        with logged_startup(self):
+            maze_name = declare(self, "maze", "obstacle", "maze name or maze YAML file")
+            robot = declare(self, "robot", "4ws-5", "robot type")
+            self.mode = declare(self, "mode", "lockstep", "lockstep or realtime")
+            gui = declare(self, "gui", False, "open the PyBullet GUI window")
+            start = declare(self, "start", "nominal", "nominal, random, or 'x,y,heading_deg'")
+            seed = declare(self, "seed", 0, "seed of a random start")
+            episode_time = finite_parameter(
+                self,
+                "episode_time",
+                30.0 if robot == HEXAPOD else 120.0,
+                "episode length T (s; default 120, hexapod 30)",
+                positive=True,
             )
-            + ["evorbc/primitive"],
-            "topics that need a publisher before the run starts",
-        )
-        self.startup_timeout = finite_parameter(
-            self, "startup_timeout", 30.0, "wall seconds to wait for the graph", positive=True
-        )
-        self.result_file = declare(self, "result_file", "", "write the result here (JSON)")
-        self.progress_period = finite_parameter(
-            self, "progress_period", 10.0, "simulated seconds between progress lines", positive=True
-        )
-        if self.mode not in ("lockstep", "realtime"):
-            raise StartupError(f"parameter mode must be lockstep or realtime, got {self.mode!r}")
-        try:
-            maze = load_named_maze(maze_name)
-        except ConfigError as e:
-            raise StartupError(f"parameter maze: {e}") from None
-        kind = bridge_robot_class(robot)
-        pose = self._start_pose(maze, start, seed, kind.geometry_type().footprint_radius)
-        self.robot = kind(self, robot, maze, pose, episode_time, gui)
+            self.lockstep_timeout = finite_parameter(
+                self,
+                "lockstep_timeout",
+                30.0,
+                "wall seconds without commands before the state is sent again anyway",
+                positive=True,
+            )
+            self.wait_subscribers = declare(
+                self,
+                "wait_for_subscribers",
+                ["scan", "odom"],
+                "topics that need a subscriber before the run starts",
+            )
+            self.wait_publishers = declare(
+                self,
+                "wait_for_publishers",
+                (
+                    ["joint_trajectory_controller/joint_trajectory"]
+                    if robot == HEXAPOD
+                    else [
+                        "steering_position_controller/commands",
+                        "wheel_velocity_controller/commands",
+                    ]
+                )
+                + ["evorbc/primitive"],
+                "topics that need a publisher before the run starts",
+            )
+            self.startup_timeout = finite_parameter(
+                self, "startup_timeout", 30.0, "wall seconds to wait for the graph", positive=True
+            )
+            self.result_file = declare(self, "result_file", "", "write the result here (JSON)")
+            self.progress_period = finite_parameter(
+                self,
+                "progress_period",
+                10.0,
+                "simulated seconds between progress lines",
+                positive=True,
+            )
+            if self.mode not in ("lockstep", "realtime"):
+                raise StartupError(
+                    f"parameter mode must be lockstep or realtime, got {self.mode!r}"
+                )
+            # Imported here, after rclpy.init: numba and PyBullet take seconds to load, and
+            # a graph shut down meanwhile (another node refused to start) would otherwise
+            # interrupt the import with a KeyboardInterrupt traceback.
+            from sim_bridge.bridge_robots import bridge_robot_class
+            from sim_bridge.maze import load_named_maze
+
+            try:
+                maze = load_named_maze(maze_name)
+            except ConfigError as e:
+                raise StartupError(f"parameter maze: {e}") from None
+            kind = bridge_robot_class(robot)
+            pose = self._start_pose(maze, start, seed, kind.geometry_type().footprint_radius, robot)
+            self.robot = kind(self, robot, maze, pose, episode_time, gui)
         self.world = self.robot.world
         self.trajectory = [list(self.world.pose)]
         self.fresh = dict.fromkeys(self.robot.command_keys, False)
@@ -143,32 +163,49 @@ class SimBridgeNode(Node):
         )
 
     @staticmethod
-    def _start_pose(maze, start: str, seed: int, clearance: float) -> tuple[float, float, float]:
-        """The start pose; its footprint (``clearance`` m about the centre) must be clear."""
+    def _start_pose(
+        maze, start: str, seed: int, clearance: float, robot: str = "the robot"
+    ) -> tuple[float, float, float]:
+        """The start pose; its footprint (``clearance`` m about the centre) must be clear.
+
+        Raises:
+            StartupError: the robot does not fit the maze where it starts (nominal or
+                random start), or an explicit ``start`` is malformed or touches a wall.
+        """
+        x, y, _ = maze.start_pose
+        room = maze.clearance(x, y)
+        if start in ("nominal", "random") and room < clearance:
+            # Not the user's start: the maze's own start region is too narrow for it.
+            hint = (
+                "" if maze.name == default_maze(robot) else f"; its maze is {default_maze(robot)}"
+            )
+            raise StartupError(
+                f"robot {robot} does not fit maze {maze.name}: at the maze's start "
+                f"({x:.2f}, {y:.2f}) m the nearest wall is {room:.3f} m away, and the robot "
+                f"needs {clearance:.3f} m{hint}"
+            )
         if start == "random":
             try:
                 return tuple(maze.sample_starts(np.random.default_rng(seed), 1, clearance)[0])
             except ValueError as e:  # a negative seed, or no start in the region fits
                 raise StartupError(f"parameter start random (seed {seed}): {e}") from None
         if start == "nominal":
-            x, y, h = maze.start_pose
-        else:
-            try:
-                x, y, h = (float(v) for v in start.split(","))
-            except ValueError:
-                raise StartupError(
-                    f"parameter start must be nominal, random or 'x,y,heading_deg', got {start!r}"
-                ) from None
-            if not all(math.isfinite(v) for v in (x, y, h)):
-                raise StartupError(f"parameter start must be finite, got {start!r}")
-            h = math.radians(h)
+            return maze.start_pose
+        try:
+            x, y, h = (float(v) for v in start.split(","))
+        except ValueError:
+            raise StartupError(
+                f"parameter start must be nominal, random or 'x,y,heading_deg', got {start!r}"
+            ) from None
+        if not all(math.isfinite(v) for v in (x, y, h)):
+            raise StartupError(f"parameter start must be finite, got {start!r}")
         room = maze.clearance(x, y)
         if room < clearance:
             raise StartupError(
                 f"parameter start: ({x:.2f}, {y:.2f}) m is {room:.3f} m from a wall of maze "
                 f"{maze.name}, but the robot needs {clearance:.3f} m"
             )
-        return x, y, h
+        return x, y, math.radians(h)
 
     # -- commands ----------------------------------------------------------------------
 
@@ -284,7 +321,7 @@ class SimBridgeNode(Node):
 
     def run_lockstep(self) -> None:
         """The lockstep loop: state out, both commands in, step."""
-        executor = rclpy.executors.SingleThreadedExecutor()
+        executor = Executor()
         executor.add_node(self)
         try:
             self.wait_for_graph(executor)
@@ -294,13 +331,14 @@ class SimBridgeNode(Node):
                 self.publish_state()
                 self.wait_for_commands(executor)
                 self.advance()
-            self.publish_state()  # final state for listeners
+            if rclpy.ok():
+                self.publish_state()  # final state for listeners
         finally:
             executor.remove_node(self)
 
     def run_realtime(self) -> None:
         """Step every 0.1 s of wall time with whatever commands are current."""
-        executor = rclpy.executors.SingleThreadedExecutor()
+        executor = Executor()
         executor.add_node(self)
         period = self.world.dt
         try:
@@ -317,14 +355,19 @@ class SimBridgeNode(Node):
         finally:
             executor.remove_node(self)
 
-    def finish(self) -> dict:
-        """Log the result and write the result file."""
+    def finish(self, interrupted: bool = False) -> dict:
+        """Write the result file and log the result (through the node while it can publish).
+
+        After SIGINT rclpy has already shut the context down, so the node's logger could
+        no longer reach ``/rosout``; the caller logs the verdict once the node is gone.
+        """
         s = self.world.status()
         result = {
             "maze": self.world.maze.name,
             "robot": self.robot.name,
             "reached": s.reached,
             "fell": s.fell,
+            "interrupted": interrupted and not s.done,
             "time": round(s.time, 3),
             "fitness": s.fitness,
             "final_distance": s.distance,
@@ -337,44 +380,61 @@ class SimBridgeNode(Node):
             if self.loop_start is None
             else (time.monotonic() - self.loop_start),
         }
-        verdict = episode_verdict(result)
-        self.get_logger().info(f"{verdict}; fitness {s.fitness:.3f}")
         if self.result_file:
             atomic_write_text(self.result_file, json.dumps(result))
+        if self.context.ok():
+            self.get_logger().info(f"{episode_verdict(result)}; fitness {s.fitness:.3f}")
         return result
 
 
 def episode_verdict(result: dict) -> str:
-    """One phrase for a result: reached, fell over, or where the time ran out."""
+    """One phrase for a result: reached, fell over, interrupted, or where the time ran out."""
     if result["reached"]:
         return f"reached the target in {result['time']:.1f} s"
     left = f"{result['final_distance']:.2f} m left"
     if result.get("fell"):
         return f"fell over after {result['time']:.1f} s ({left})"
+    if result.get("interrupted"):
+        return f"interrupted after {result['time']:.1f} s ({left})"
     return f"did not reach the target ({left} after {result['time']:.1f} s)"
 
 
 def main(argv=None) -> int:
-    """Run one episode and exit."""
-    rclpy.init(args=argv)
-    node = None
+    """Run one episode and exit: 0 when it ran (or was interrupted), 2 if it cannot start."""
+    status = init_ros(argv)
+    if status is not None:
+        return status
+    node, result = None, None
     try:
         node = SimBridgeNode()
         if node.mode == "lockstep":
             node.run_lockstep()
         else:
             node.run_realtime()
-        node.finish()
+        result = node.finish(interrupted=not rclpy.ok())
     except StartupError as e:
-        print(f"error: {e}", file=sys.stderr)
+        if not e.logged:
+            print(f"error: {e}", file=sys.stderr)
         return 2
-    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
+    except Exception as e:
+        if not isinstance(e, rclpy.executors.ExternalShutdownException) and not stop_requested():
+            raise
+        if node is not None:  # stopped by a signal, maybe as the context went away
+            result = node.finish(interrupted=True)
+    except KeyboardInterrupt:
         if node is not None:
-            node.finish()
+            result = node.finish(interrupted=True)
     finally:
+        quiet_teardown()
         if node is not None:
             node.world.close()
+            logged = node.context.ok()
             node.destroy_node()
+            if result is not None and not logged:
+                # The node is gone, so this reaches the console and the log file only.
+                rclpy.logging.get_logger("sim_bridge").info(
+                    f"{episode_verdict(result)}; fitness {result['fitness']:.3f}"
+                )
         rclpy.try_shutdown()
     return 0
 

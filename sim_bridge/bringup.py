@@ -3,8 +3,9 @@
 Starts ``sim_bridge`` and the four evorbc nodes (``laser_sensor``, ``radar_sensor``,
 ``arbitrator``, ``primitive_executor``) as processes on this machine, runs one maze
 episode, prints the result, writes a trajectory picture, and shuts everything down; Ctrl-C
-stops the run cleanly. The same graph comes up with ``ros2 launch evorbc_ros sim.launch.py``
-for users who have ROS 2's launch.
+stops the run cleanly (status 130). The nodes and their parameters come from
+:mod:`sim_bridge.graph`, which ``ros2 launch evorbc_ros sim.launch.py`` uses too, so both
+bring up the same graph.
 """
 
 from __future__ import annotations
@@ -23,13 +24,14 @@ from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.cli_support import check_output_file, report_unexpected
 from evorbc_ros.config import ConfigError, config_dir
-from evorbc_ros.defaults import default_arbitrator
+from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, shipped_robots
 from evorbc_ros.nodes.common import StartupError
 from evorbc_ros.repertoire import RepertoireError
 from evorbc_ros.robots.hexapod import HEXAPOD, HexapodGeometry
 from evorbc_ros.sensors import SensorLayout
 from sim_bridge.bridge_node import SimBridgeNode, episode_verdict
 from sim_bridge.bridge_robots import ROBOTS, bridge_robot_class
+from sim_bridge.graph import NodeSpec, exit_ends_graph, sim_graph
 from sim_bridge.hexapod.maze_world import DEFAULT_SENSORS
 from sim_bridge.hexapod.physics import PhysicsSettings
 from sim_bridge.maze import Maze, load_named_maze, maze_names
@@ -38,12 +40,15 @@ from sim_bridge.robots.hexapod import check_simulation, describe_simulation, sim
 #: Highest ROS_DOMAIN_ID: DDS derives UDP ports from it, and above 232 they pass 65535.
 MAX_DOMAIN_ID = 232
 
-NODES = {
-    "laser_sensor": "evorbc_ros.nodes.laser_sensor",
-    "radar_sensor": "evorbc_ros.nodes.radar_sensor",
-    "arbitrator": "evorbc_ros.nodes.arbitrator",
-    "primitive_executor": "evorbc_ros.nodes.primitive_executor",
-}
+#: The evorbc nodes' modules, by node name (tests start single nodes with these).
+NODES = {n.name: n.module for n in sim_graph().nodes if n.package == "evorbc_ros"}
+
+
+class _Parser(argparse.ArgumentParser):
+    """Usage errors in one line (no usage block), status 2."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 def _int_range(low: int, high: int | None = None):
@@ -64,7 +69,7 @@ def _int_range(low: int, high: int | None = None):
 
 def parse_args(argv=None) -> argparse.Namespace:
     """Command-line options of ``evorbc-sim``."""
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="evorbc-sim",
         description="Run an evolved controller through the ROS 2 graph "
         "against the PyBullet simulation bridge, one maze episode.",
@@ -112,9 +117,18 @@ def parse_args(argv=None) -> argparse.Namespace:
     return p.parse_args(argv)
 
 
-def node_command(module: str, params: dict) -> list[str]:
-    """``python -m module --ros-args -p k:=v ...`` (empty values are left out)."""
+def node_command(
+    module: str, params: dict, param_file: Path | None = None, namespace: str = ""
+) -> list[str]:
+    """``python -m module --ros-args [--params-file F] [-r __ns:=/NS] -p k:=v ...``.
+
+    Empty values are left out; ``-p`` overrides win over the file.
+    """
     cmd = [sys.executable, "-m", module, "--ros-args"]
+    if param_file is not None:
+        cmd += ["--params-file", str(param_file)]
+    if namespace:
+        cmd += ["-r", f"__ns:=/{namespace}"]
     for key, value in params.items():
         if value == "":
             continue  # rcl cannot parse an empty override; every empty default means "none"
@@ -130,18 +144,20 @@ class Graph:
         self.env = env
         self.quiet = quiet
         self.procs: dict[str, subprocess.Popen] = {}
+        self.specs: dict[str, NodeSpec] = {}
 
-    def start(self, name: str, module: str, params: dict) -> subprocess.Popen:
+    def start(self, spec: NodeSpec, namespace: str = "") -> subprocess.Popen:
         """Start one node; its output is shown unless quiet."""
         out = subprocess.DEVNULL if self.quiet else None
         proc = subprocess.Popen(
-            node_command(module, params),
+            node_command(spec.module, spec.parameters, spec.param_file, namespace),
             env=self.env,
             stdout=out,
             stderr=out,
             start_new_session=True,
         )
-        self.procs[name] = proc
+        self.procs[spec.name] = proc
+        self.specs[spec.name] = spec
         return proc
 
     def stop(self, timeout: float = 5.0) -> None:
@@ -189,28 +205,19 @@ def start_graph(
     graph: Graph, args: argparse.Namespace, robot: str, arb_path: str, result_file: str
 ) -> subprocess.Popen:
     """Start the four evorbc nodes and then the bridge, which runs the episode."""
-    sim_time = {"use_sim_time": True}
-    graph.start("laser_sensor", NODES["laser_sensor"], {**sim_time, "sensor_layout": arb_path})
-    graph.start("radar_sensor", NODES["radar_sensor"], {**sim_time, "sensor_layout": arb_path})
-    graph.start(
-        "arbitrator",
-        NODES["arbitrator"],
-        {**sim_time, "arbitrator": arb_path, "repertoire": args.repertoire},
+    spec = sim_graph(
+        robot=robot,
+        maze=args.maze,
+        mode=args.mode,
+        gui=args.gui,
+        arbitrator=arb_path,
+        repertoire=args.repertoire,
+        start=args.start,
+        seed=args.seed,
+        result_file=result_file,
     )
-    graph.start("primitive_executor", NODES["primitive_executor"], {**sim_time, "robot": robot})
-    return graph.start(
-        "sim_bridge",
-        "sim_bridge.bridge_node",
-        {
-            "maze": args.maze,
-            "robot": robot,
-            "mode": args.mode,
-            "gui": args.gui,
-            "start": args.start,
-            "seed": args.seed,
-            "result_file": result_file,
-        },
-    )
+    procs = [graph.start(node, spec.namespace) for node in spec.nodes]
+    return procs[-1]  # the bridge, started last: it waits for the others anyway
 
 
 def check_start(start: str, seed: int, maze: Maze, robot: str) -> None:
@@ -223,9 +230,12 @@ def check_start(start: str, seed: int, maze: Maze, robot: str) -> None:
     clearance = bridge_robot_class(robot).geometry_type().footprint_radius
     try:
         # The bridge's own check, so that both refuse the same starts.
-        x, y, _ = SimBridgeNode._start_pose(maze, start, seed, clearance)
+        x, y, _ = SimBridgeNode._start_pose(maze, start, seed, clearance, robot)
     except StartupError as e:
-        raise ConfigError("--start" + str(e).removeprefix("parameter start")) from None
+        message = str(e)
+        if message.startswith("parameter start"):
+            message = "--start" + message.removeprefix("parameter start")
+        raise ConfigError(message) from None
     # Far outside, no wall is near, so the clearance check passes; the robot would just
     # drive the whole episode in empty space.
     x0, y0, x1, y1 = maze.bounds()
@@ -243,6 +253,11 @@ def prepare(args: argparse.Namespace) -> tuple[Controller, Maze, str]:
         The controller the arbitrator node will load, the maze and the picture path.
 
     """
+    if not args.arbitrator and args.robot and args.robot not in shipped_robots():
+        raise ConfigError(
+            f"{no_shipped_controller(args.robot)}, then run "
+            "'evorbc-sim --arbitrator a.json --repertoire r.json'"
+        )
     arb_path = args.arbitrator or str(default_arbitrator(args.robot or "4ws-5"))
     controller = Controller(arb_path, args.repertoire)
     arb = controller.spec
@@ -269,7 +284,7 @@ def main(argv=None) -> int:
         print(f"evorbc-sim: error: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print("evorbc-sim: aborted", file=sys.stderr)
+        print("evorbc-sim: interrupted", file=sys.stderr)
         return 130
     except Exception as e:
         return report_unexpected("evorbc-sim", e)
@@ -300,16 +315,17 @@ def run(args: argparse.Namespace) -> int:
                 )
             while bridge.poll() is None:
                 for name, proc in graph.procs.items():
-                    if name != "sim_bridge" and proc.poll() not in (None, 0):
-                        print(
-                            f"evorbc-sim: error: node {name} exited with status {proc.returncode}",
-                            file=sys.stderr,
-                        )
+                    spec = graph.specs[name]
+                    reason = "" if spec.required else exit_ends_graph(spec, proc.poll())
+                    if reason:  # the graph is useless without this node
+                        print(f"evorbc-sim: error: {reason}", file=sys.stderr)
                         return 1
                 time.sleep(0.05)
         except KeyboardInterrupt:
             interrupted = True
-            print("\nevorbc-sim: stopping the graph", file=sys.stderr)
+            # A second Ctrl-C must not cut the shutdown short and leave nodes running.
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            print("\nevorbc-sim: interrupted; stopping the graph", file=sys.stderr)
         finally:
             graph.stop()  # also when anything above failed: no node outlives evorbc-sim
         if bridge is None:
@@ -323,13 +339,14 @@ def run(args: argparse.Namespace) -> int:
             return 130 if interrupted else 1
         result = json.loads(Path(result_file).read_text())
     verdict = episode_verdict(result)
-    print(f"{maze.name}: {verdict}, fitness {result['fitness']:.3f} ({args.mode}) -> {plot}")
+    fitness = "" if result.get("interrupted") else f", fitness {result['fitness']:.3f}"
+    print(f"{maze.name}: {verdict}{fitness} ({args.mode}) -> {plot}")
     from sim_bridge.maze_plot import plot_run
 
     plot_run(
         maze,
         result["trajectory"],
-        f"{maze.name} via ROS 2 ({args.mode}): {verdict}, fitness {result['fitness']:.3f}",
+        f"{maze.name} via ROS 2 ({args.mode}): {verdict}{fitness}",
         plot,
         episode_time=result["episode_time"],
     )

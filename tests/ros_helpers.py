@@ -4,6 +4,7 @@ Nothing sleeps blindly: :meth:`Ros.spin_until` spins the executor until a condit
 or a deadline passes.
 """
 
+import contextlib
 import time
 
 import pytest
@@ -32,12 +33,13 @@ class Ros:
         self.executor.add_node(node)
         return node
 
-    def make(self, cls, sim_time=False, **params):
+    def make(self, cls, sim_time=False, namespace=None, **params):
         """Construct a node class with parameter overrides in this context."""
         overrides = [Parameter(k, value=v) for k, v in params.items()]
         if sim_time:
             overrides.append(Parameter("use_sim_time", value=True))
-        return self.add(cls(context=self.context, parameter_overrides=overrides))
+        extra = {} if namespace is None else {"namespace": namespace}
+        return self.add(cls(context=self.context, parameter_overrides=overrides, **extra))
 
     def spin_until(self, condition, timeout=5.0):
         """Spin until ``condition()`` is true; False if ``timeout`` seconds pass first."""
@@ -96,12 +98,24 @@ class Ros:
         rclpy.try_shutdown(context=self.context)
 
 
+@contextlib.contextmanager
+def ros_with_args(*args):
+    """A :class:`Ros` whose context has ``--ros-args args`` (parameter files, remappings).
+
+    Set ``ROS_AUTOMATIC_DISCOVERY_RANGE=OFF`` first (the ``ros`` fixture does).
+    """
+    context = rclpy.Context()
+    rclpy.init(context=context, args=["--ros-args", *args] if args else None)
+    r = Ros(context)
+    try:
+        yield r
+    finally:
+        r.close()
+
+
 @pytest.fixture
 def ros(monkeypatch):
     """A hermetic in-process ROS 2 setup (no discovery outside this process)."""
     monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")
-    context = rclpy.Context()
-    rclpy.init(context=context)
-    r = Ros(context)
-    yield r
-    r.close()
+    with ros_with_args() as r:
+        yield r

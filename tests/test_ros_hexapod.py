@@ -222,10 +222,19 @@ def test_evorbc_sim_refuses_a_start_inside_the_legs_reach_before_starting_the_gr
     old = tmp_path / "result.json"
     old.write_text('{"reached": true}')
     argv = ["--arbitrator", str(arb_path), "--repertoire", str(rep_path), "--quiet"]
-    # The obstacle maze's nominal start is 0.09 m from a wall; the legs reach 0.31 m.
+    # The obstacle maze's nominal start is 0.09 m from a wall; the legs reach 0.31 m. No
+    # --start was given: the robot does not fit the maze.
     assert main([*argv, "--maze", "obstacle", "--result", str(old), "--plot", ""]) == 1
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("evorbc-sim: error: --start: (")
+    assert err == [
+        "evorbc-sim: error: robot hexapod does not fit maze obstacle: at the maze's start "
+        "(-5.46, 0.65) m the nearest wall is 0.094 m away, and the robot needs 0.313 m; "
+        "its maze is hexapod"
+    ]
+    # A start the user gives is what is blamed.
+    assert main([*argv, "--maze", "obstacle", "--start=-5.46,0.65,0", "--plot", ""]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("evorbc-sim: error: --start: (-5.46, 0.65) m is")
     assert "m from a wall of maze obstacle" in err[0]
     assert old.exists()  # refused before anything ran: nothing of the user's is touched
 

@@ -224,27 +224,3 @@ def test_bad_parameters_stop_a_node_at_start_up(ros, cls, params, needle):
 def test_a_whole_number_is_accepted_for_a_real_parameter(ros):
     node = ros.make(PrimitiveExecutorNode, robot="hexapod", trajectory_rate=100, period=1)
     assert node.logic.dt == pytest.approx(0.01) and node.period == 1.0
-
-
-@pytest.mark.parametrize(
-    ("section", "cls", "robot"),
-    [
-        ("laser_sensor", LaserSensorNode, None),
-        ("radar_sensor", RadarSensorNode, None),
-        ("arbitrator", ArbitratorNode, None),
-        ("primitive_executor", PrimitiveExecutorNode, None),
-        ("primitive_executor", PrimitiveExecutorNode, "hexapod"),
-    ],
-)
-def test_the_shipped_parameter_file_sets_only_declared_parameters(ros, section, cls, robot):
-    import yaml
-
-    params = yaml.safe_load((config_dir() / "ros" / "evorbc_nodes.yaml").read_text())
-    params = params[section]["ros__parameters"]
-    if robot:
-        params = {**params, "robot": robot}
-    node = ros.make(cls, **params)
-    undeclared = {k for k in params if not node.has_parameter(k)}
-    assert not undeclared
-    for key, value in params.items():
-        assert node.get_parameter(key).value == value

@@ -8,9 +8,12 @@ executables, without the ros2 CLI; with it, ``ros2 run`` itself is tried too.
 
 import os
 import py_compile
+import re
 import shutil
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -49,6 +52,14 @@ def prefix(tmp_path_factory):
         capture_output=True,
     )
     return out
+
+
+def assert_startup_error(stderr: str, node: str, message: str) -> None:
+    """The node's last line is its logger's one-line start-up error, and no traceback."""
+    assert "Traceback" not in stderr
+    last = stderr.strip().splitlines()[-1]
+    pattern = rf"\[FATAL\] \[[0-9.]+\] \[{node}\]: cannot start: {re.escape(message)}"
+    assert re.fullmatch(pattern, last), last
 
 
 def site_packages(prefix: Path) -> Path:
@@ -117,7 +128,7 @@ def test_an_installed_node_starts_and_reports_bad_files(prefix, tmp_path):
         cwd=tmp_path,
     )
     assert done.returncode == 2, done.stderr
-    assert done.stderr.strip().splitlines()[-1] == f"error: {missing}: no such arbitrator file"
+    assert_startup_error(done.stderr, "arbitrator", f"{missing}: no such arbitrator file")
     # It ran the installed copy, whose settings come from the prefix's share folder.
     script = "from evorbc_ros.config import config_dir; print(config_dir())"
     where = subprocess.run(
@@ -141,7 +152,12 @@ def test_the_launch_file_is_valid_python():
     py_compile.compile(str(ROOT / "launch" / "sim.launch.py"), doraise=True)
 
 
-@pytest.mark.skipif(shutil.which("ros2") is None, reason="needs the ros2 CLI (full ROS 2)")
+needs_ros2 = pytest.mark.skipif(
+    shutil.which("ros2") is None, reason="needs the ros2 CLI (full ROS 2)"
+)
+
+
+@needs_ros2
 def test_ros2_run_finds_the_arbitrator(prefix, tmp_path):
     missing = tmp_path / "missing.json"
     done = subprocess.run(
@@ -154,7 +170,7 @@ def test_ros2_run_finds_the_arbitrator(prefix, tmp_path):
     assert "no such arbitrator file" in done.stderr
 
 
-@pytest.mark.skipif(shutil.which("ros2") is None, reason="needs the ros2 CLI (full ROS 2)")
+@needs_ros2
 def test_the_launch_file_builds_a_description(prefix):
     script = (
         "import runpy; d = runpy.run_path('launch/sim.launch.py')"
@@ -169,3 +185,100 @@ def test_the_launch_file_builds_a_description(prefix):
         timeout=60,
     )
     assert done.returncode == 0 and int(done.stdout) == 10
+
+
+def graph_env(prefix: Path, domain: int) -> dict:
+    """The installed copy, with discovery on this machine (the nodes must find each other)."""
+    return {
+        **installed_env(prefix),
+        "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+        "ROS_DOMAIN_ID": str(domain),
+        "PYTHONUNBUFFERED": "1",
+    }
+
+
+def ros2_launch(prefix, domain, *args, timeout=300) -> str:
+    """``ros2 launch evorbc_ros sim.launch.py ARGS``: its whole output, once it ended itself."""
+    done = subprocess.run(
+        ["ros2", "launch", "evorbc_ros", "sim.launch.py", *args],
+        env=graph_env(prefix, domain),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        timeout=timeout,
+    )
+    assert done.returncode == 0, done.stdout
+    assert "Traceback" not in done.stdout
+    return done.stdout
+
+
+@needs_ros2
+def test_ros2_launch_shows_every_argument_with_its_description(prefix):
+    from sim_bridge.graph import ARGUMENTS
+
+    out = ros2_launch(prefix, 170, "--show-args", timeout=60)
+    for a in ARGUMENTS:
+        assert f"'{a.name}':\n        {a.description}\n        (default: '{a.default}')" in out
+
+
+@needs_ros2
+def test_ros2_launch_runs_an_episode_in_a_namespace_and_then_shuts_the_graph_down(prefix):
+    out = ros2_launch(prefix, 171, "maze:=zigzag", "namespace:=robot1")
+    # The shipped controller, as offline (evorbc_ros/data/README.md: zigzag 86.0 s, 1.283).
+    assert "[robot1.sim_bridge]: reached the target in 86.0 s; fitness 1.283" in out
+    assert re.search(r"process\[sim_bridge-\d\] was required: shutting down", out)
+    assert out.count("process has finished cleanly") == 5
+
+
+@needs_ros2
+def test_ros2_launch_refuses_a_controller_for_another_robot_and_ends(prefix):
+    arb = site_packages(prefix) / "evorbc_ros" / "data" / "4ws-5.arbitrator.json"
+    out = ros2_launch(prefix, 172, "robot:=4ws-3", f"arbitrator:={arb}", timeout=120)
+    assert (
+        f"[arbitrator]: cannot start: {arb}: is a controller for robot 4ws-5, "
+        "but parameter robot is 4ws-3"
+    ) in out
+    assert "sim_bridge]: t =" not in out  # the graph shut down before any episode ran
+
+
+@needs_ros2
+def test_ros2_param_set_refuses_read_only_and_ros2_topic_pub_goals_arrive(prefix):
+    env = graph_env(prefix, 173)
+    node = subprocess.Popen(
+        ["ros2", "run", "evorbc_ros", "radar_sensor"],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,  # its own group: Ctrl-C reaches ros2 run and the node
+    )
+    try:
+
+        def ros2(*args):
+            cmd = ["ros2", *args]
+            return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=60)
+
+        cli = ("--no-daemon", "--spin-time", "2")
+        deadline = time.monotonic() + 60
+        done = ros2("param", "set", *cli, "/radar_sensor", "goal_type", "pose")
+        while "Node not found" in done.stderr and time.monotonic() < deadline:  # starting
+            done = ros2("param", "set", *cli, "/radar_sensor", "goal_type", "pose")
+        assert done.stderr.strip() == (
+            "Setting parameter failed: Trying to set a read-only parameter: goal_type."
+        )
+        done = ros2("param", "get", *cli, "/radar_sensor", "goal_type")
+        assert done.stdout.strip() == "String value is: point"
+        goal = "{header: {frame_id: odom}, point: {x: 1.5, y: -0.5}}"
+        done = ros2(
+            "topic", "pub", "--once", "-w", "1", "goal", "geometry_msgs/msg/PointStamped", goal
+        )
+        assert done.returncode == 0, done.stderr
+        time.sleep(1.0)
+    finally:
+        for _ in range(2):  # Ctrl-C twice, as ros2 launch run from a script does
+            os.killpg(node.pid, signal.SIGINT)
+            time.sleep(0.05)
+        out = node.communicate(timeout=30)[0]
+    assert node.returncode == 0, out
+    assert "goal (1.500, -0.500) in frame 'odom'" in out
+    assert "Traceback" not in out and "incompatible QoS" not in out

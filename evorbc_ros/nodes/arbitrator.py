@@ -6,7 +6,8 @@ both have a new message it publishes the chosen primitive's genes on ``evorbc/pr
 ``evorbc/mapping`` = ``[m1, m2, x, y, primitive index]``, also appended to ``record_file``
 (JSON lines) if set. By default it runs the arbitrator
 and repertoire shipped with the package, so ``ros2 run evorbc_ros arbitrator`` needs no
-arguments. Bad files or a repertoire/sensor mismatch stop it at start-up with one line.
+arguments. Bad files, a repertoire/sensor mismatch, or a controller for another robot
+than the ``robot`` parameter stop it at start-up with one line.
 """
 
 from __future__ import annotations
@@ -19,13 +20,16 @@ from std_msgs.msg import Float64MultiArray
 
 from evorbc_ros.arbitration import Controller, InputGroups
 from evorbc_ros.arbitrator import ArbitratorError
+from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, shipped_robots
 from evorbc_ros.laser import InputError
 from evorbc_ros.nodes.common import (
     DIAGNOSTICS,
     RELIABLE,
+    ROBOTS,
     StartupError,
     declare,
     load_sensor_layout,
+    logged_startup,
     run_node,
     vector_message,
     vector_values,
@@ -38,68 +42,75 @@ class ArbitratorNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__("arbitrator", **kwargs)
-        arbitrator = declare(
-            self, "arbitrator", "", "arbitrator file (JSON); empty: the shipped 4ws-5 arbitrator"
-        )
-        repertoire = declare(
-            self, "repertoire", "", "repertoire file (JSON); empty: the shipped one for its robot"
-        )
-        allow = declare(
-            self,
-            "allow_mismatch",
-            False,
-            "run with a repertoire or sensor layout other than the arbitrator's",
-        )
-        layout_path = declare(
-            self,
-            "sensor_layout",
-            "",
-            "the sensor nodes' layout (YAML); empty: the arbitrator's own",
-        )
-        try:
-            self.controller = Controller(arbitrator, repertoire, allow)
-            spec = self.controller.spec
-            if layout_path:
-                self.controller.warnings += spec.check_sensors(
-                    load_sensor_layout(layout_path), layout_path, allow
-                )
-        except (ArbitratorError, RepertoireError) as e:
-            raise StartupError(str(e)) from None
+        with logged_startup(self):
+            arbitrator = declare(
+                self,
+                "arbitrator",
+                "",
+                "arbitrator file (JSON); empty: the shipped one for robot (4ws-5 if unset)",
+            )
+            repertoire = declare(
+                self,
+                "repertoire",
+                "",
+                "repertoire file (JSON); empty: the shipped one for its robot",
+            )
+            robot = declare(
+                self,
+                "robot",
+                "",
+                f"the robot driven ({', '.join(ROBOTS)}): a controller for another is refused; "
+                "empty: not checked",
+            )
+            allow = declare(
+                self,
+                "allow_mismatch",
+                False,
+                "run with a repertoire or sensor layout other than the arbitrator's",
+            )
+            layout_path = declare(
+                self,
+                "sensor_layout",
+                "",
+                "the sensor nodes' layout (YAML); empty: the arbitrator's own",
+            )
+            self.controller = load_controller(arbitrator, repertoire, robot, allow, layout_path)
+            rf_topic = declare(
+                self,
+                "rangefinder_topic",
+                "evorbc/rangefinders",
+                "rangefinder readings (Float64MultiArray)",
+            )
+            goal_topic = declare(
+                self, "goal_topic", "evorbc/goal_sectors", "goal readings (Float64MultiArray)"
+            )
+            out_topic = declare(
+                self,
+                "primitive_topic",
+                "evorbc/primitive",
+                "chosen primitive's genes (Float64MultiArray)",
+            )
+            map_topic = declare(
+                self,
+                "mapping_topic",
+                "evorbc/mapping",
+                "diagnostics [m1, m2, x, y, primitive] (Float64MultiArray)",
+            )
+            record = declare(
+                self,
+                "record_file",
+                "",
+                "append every choice here as JSON lines (m1, m2, x, y, primitive)",
+            )
+            try:
+                self.record = open(record, "a", buffering=1) if record else None  # noqa: SIM115
+            except OSError as e:
+                raise StartupError(
+                    f"parameter record_file: cannot open {record} ({e.strerror})"
+                ) from None
         for w in self.controller.warnings:
             self.get_logger().warning(w)
-        rf_topic = declare(
-            self,
-            "rangefinder_topic",
-            "evorbc/rangefinders",
-            "rangefinder readings (Float64MultiArray)",
-        )
-        goal_topic = declare(
-            self, "goal_topic", "evorbc/goal_sectors", "goal readings (Float64MultiArray)"
-        )
-        out_topic = declare(
-            self,
-            "primitive_topic",
-            "evorbc/primitive",
-            "chosen primitive's genes (Float64MultiArray)",
-        )
-        map_topic = declare(
-            self,
-            "mapping_topic",
-            "evorbc/mapping",
-            "diagnostics [m1, m2, x, y, primitive] (Float64MultiArray)",
-        )
-        record = declare(
-            self,
-            "record_file",
-            "",
-            "append every choice here as JSON lines (m1, m2, x, y, primitive)",
-        )
-        try:
-            self.record = open(record, "a", buffering=1) if record else None  # noqa: SIM115
-        except OSError as e:
-            raise StartupError(
-                f"parameter record_file: cannot open {record} ({e.strerror})"
-            ) from None
+        spec = self.controller.spec
         layout = spec.sensors
         n_rf = len(layout.rangefinders.angles) if layout.rangefinders else 0
         sizes = {rf_topic: n_rf, goal_topic: layout.n_inputs - n_rf}
@@ -144,6 +155,44 @@ class ArbitratorNode(Node):
             self.record.close()
             self.record = None
         super().destroy_node()
+
+
+def load_controller(
+    arbitrator: str, repertoire: str, robot: str, allow: bool, layout_path: str
+) -> Controller:
+    """The controller the parameters name, checked against ``robot`` and the sensor layout.
+
+    An empty ``arbitrator`` means the one shipped for ``robot`` (4ws-5 if ``robot`` is
+    empty). A controller for another robot than ``robot`` could never drive it: its
+    primitives have other parameters (DESIGN.md section 9), so it is refused here, not
+    discovered later as a robot that never moves.
+
+    Raises:
+        StartupError: one line naming the parameter or file and the problem.
+    """
+    if robot and robot not in ROBOTS:
+        raise StartupError(f"parameter robot must be one of {', '.join(ROBOTS)}, got {robot!r}")
+    if not arbitrator and robot:
+        if robot not in shipped_robots():
+            raise StartupError(
+                f"parameter robot: {no_shipped_controller(robot)}; then set "
+                "arbitrator:=a.json and repertoire:=r.json"
+            )
+        arbitrator = str(default_arbitrator(robot))
+    try:
+        controller = Controller(arbitrator, repertoire, allow)
+        if layout_path:
+            controller.warnings += controller.spec.check_sensors(
+                load_sensor_layout(layout_path), layout_path, allow
+            )
+    except (ArbitratorError, RepertoireError) as e:
+        raise StartupError(str(e)) from None
+    if robot and controller.spec.robot != robot:
+        raise StartupError(
+            f"{controller.arbitrator_path}: is a controller for robot {controller.spec.robot}, "
+            f"but parameter robot is {robot}"
+        )
+    return controller
 
 
 def main(argv=None) -> int:

@@ -4,12 +4,19 @@ Conventions (DESIGN.md section 9): sensor streams from other stacks are subscrib
 ``qos_profile_sensor_data``; everything evorbc publishes is reliable (a best-effort
 subscriber still receives it); the goal is latched (transient local) so a node that starts
 late still gets it.
+
+Parameters are read once, at start-up, and declared read-only, so ``ros2 param set`` says
+so instead of claiming a success that changes nothing; the few that a node applies live
+say so in their description and are validated when set. A node that cannot start logs one
+line through its own logger (console, ``/rosout`` and the log file) and exits with status 2.
 """
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 
 import numpy as np
 import rclpy
@@ -42,8 +49,96 @@ LATCHED = QoSProfile(
 SENSOR_DATA = qos_profile_sensor_data
 
 
+def _robot_names() -> tuple[str, ...]:
+    from evorbc_ros.robots.four_ws import ROBOT_TYPES
+    from evorbc_ros.robots.hexapod import HEXAPOD
+
+    return (*ROBOT_TYPES, HEXAPOD)
+
+
+#: Every robot type the nodes drive: the 4WS types (2ws-2, 2ws-3, 4ws-3, 4ws-5), hexapod.
+ROBOTS = _robot_names()
+
+
 class StartupError(Exception):
     """A node cannot start (bad parameter or file); the message says which and why."""
+
+    #: Set once the node has logged the error through its logger.
+    logged = False
+
+
+@contextlib.contextmanager
+def logged_startup(node: Node) -> Iterator[None]:
+    """Log a :class:`StartupError` raised inside through ``node``'s logger, then re-raise.
+
+    The node exists by then, so the line reaches ``/rosout`` and the ROS log file as well
+    as the console, where ``ros2 launch`` users and log collectors look for it.
+    """
+    try:
+        yield
+    except StartupError as e:
+        node.get_logger().fatal(f"cannot start: {e}")
+        e.logged = True
+        raise
+
+
+_stopping = False
+
+
+def stop_on_first_signal() -> None:
+    """Make SIGINT and SIGTERM stop the node once; later ones are ignored.
+
+    Call before ``rclpy.init``. rclpy's own handler then chains to this one: on the first
+    signal rclpy shuts the context down and wakes the executor, so ``spin`` and the
+    bridge's loops end by themselves; this handler only notes the stop. Raising
+    KeyboardInterrupt there instead would land anywhere, in a numba compiler callback or
+    in ``destroy_node``, and print a traceback. Only while rclpy's handler is not
+    installed (inside ``rclpy.init``) does the first signal raise KeyboardInterrupt.
+    ``ros2 launch`` run from a script sends a second SIGINT while the nodes shut down:
+    it is ignored.
+    """
+    from rclpy.signals import SignalHandlerOptions, get_current_signal_handlers_options
+
+    def on_signal(signum, frame) -> None:
+        global _stopping
+        if _stopping:
+            return
+        _stopping = True
+        if get_current_signal_handlers_options() == SignalHandlerOptions.NO:
+            raise KeyboardInterrupt  # rclpy is not listening yet: nothing else would stop
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+
+
+def stop_requested() -> bool:
+    """True once SIGINT or SIGTERM arrived (see :func:`stop_on_first_signal`).
+
+    rclpy's signal thread shuts the context down at once, so a node still being built
+    then fails with "context is not valid": that is a stop, not an error.
+    """
+    return _stopping
+
+
+def quiet_teardown() -> None:
+    """Ignore SIGINT and SIGTERM from now on: the process is finishing anyway.
+
+    rclpy's signal thread shuts contexts down and triggers the executors' guard conditions
+    on every signal; a second signal while the node and executor are being destroyed would
+    touch objects being freed, so rclpy's handlers go first. The signals are then ignored
+    at the OS level: Python restores the default action of every signal it handled as it
+    exits, and a late SIGINT would then kill the process (status -2) after a clean stop.
+    """
+    from rclpy.signals import uninstall_signal_handlers
+
+    uninstall_signal_handlers()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    # CPython marks the process as ended by Ctrl-C when a KeyboardInterrupt leaves code run
+    # by exec() of a string (numba and dataclasses compile that way), even once caught,
+    # and then kills itself with SIGINT as it exits (status -2 after a clean stop). Each
+    # such exec() clears the mark first; this one clears it for good.
+    exec("None")
 
 
 def vector_message(values: Sequence[float], names: Sequence[str] = ()) -> Float64MultiArray:
@@ -77,38 +172,83 @@ def now_seconds(node: Node) -> float:
     return node.get_clock().now().nanoseconds * 1e-9
 
 
-def run_node(make: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
-    """Init / construct / spin / destroy / try_shutdown, with one-line start-up errors."""
+class Executor(rclpy.executors.SingleThreadedExecutor):
+    """rclpy's single-threaded executor, safe to make while a signal stops the process.
+
+    Made just as the signal shuts the context down, its ``__init__`` fails; rclpy's
+    ``__del__`` then reads an attribute that was never set and prints a traceback. The
+    class attribute gives it one.
+    """
+
+    _sigint_gc = None
+
+
+def init_ros(argv: Sequence[str] | None) -> int | None:
+    """``rclpy.init`` after :func:`stop_on_first_signal`.
+
+    Returns:
+        None to go on; otherwise the exit status: 2 after one line on bad arguments, 0 if
+        a signal came first.
+    """
+    stop_on_first_signal()
     try:
         rclpy.init(args=argv)
+    except KeyboardInterrupt:
+        quiet_teardown()
+        rclpy.try_shutdown()
+        return 0
     except Exception as e:  # rcl reports bad --ros-args as a generic RCLError
         first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
         print(f"error: cannot start: {first}", file=sys.stderr)
         return 2
+    return None
+
+
+def run_node(make: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
+    """Init / construct / spin / destroy / try_shutdown (the ROS 2 demos' main).
+
+    Returns 0 after Ctrl-C or SIGTERM, 2 if the node cannot start (the node has logged
+    why; see :func:`logged_startup`).
+    """
+    status = init_ros(argv)
+    if status is not None:
+        return status
     node = None
     try:
         node = make()
-        rclpy.spin(node)
+        rclpy.spin(node, Executor())
     except StartupError as e:
-        print(f"error: {e}", file=sys.stderr)
+        if not e.logged:
+            print(f"error: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
         pass
-    except rclpy.executors.ExternalShutdownException:
-        pass
+    except Exception:
+        if not stop_requested():
+            raise
     finally:
+        quiet_teardown()
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
     return 0
 
 
-def declare(node: Node, name: str, default, description: str, any_type: bool = False):
+def declare(
+    node: Node,
+    name: str,
+    default,
+    description: str,
+    any_type: bool = False,
+    live: bool = False,
+):
     """Declare a parameter with a description and return its value.
 
     Args:
         any_type: accept an override of any type (the caller checks it), so that
             ``-p rate:=100`` reaches a float parameter as an int instead of failing.
+        live: the node applies changes while it runs (and validates them in its
+            set-parameters callback); otherwise the parameter is read-only after start-up.
 
     Raises:
         StartupError: the override has another type than ``default``.
@@ -116,7 +256,11 @@ def declare(node: Node, name: str, default, description: str, any_type: bool = F
     from rcl_interfaces.msg import ParameterDescriptor
     from rclpy.exceptions import InvalidParameterTypeException
 
-    descriptor = ParameterDescriptor(description=description, dynamic_typing=any_type)
+    descriptor = ParameterDescriptor(
+        description=description,
+        dynamic_typing=any_type,
+        read_only=not live,
+    )
     try:
         return node.declare_parameter(name, default, descriptor).value
     except InvalidParameterTypeException:
@@ -162,14 +306,27 @@ def sensor_layout_parameter(node: Node):
 
 
 def finite_parameter(
-    node: Node, name: str, default: float, description: str, positive: bool = False
+    node: Node,
+    name: str,
+    default: float,
+    description: str,
+    positive: bool = False,
+    live: bool = False,
 ) -> float:
     """Declare a float parameter and check it is finite (and > 0 if ``positive``)."""
+    value = declare(node, name, float(default), description, any_type=True, live=live)
+    problem = finite_problem(name, value, positive)
+    if problem:
+        raise StartupError(problem)
+    return float(value)
+
+
+def finite_problem(name: str, value, positive: bool = False) -> str:
+    """Why ``value`` is not a finite (positive) number for parameter ``name``; "" if it is."""
     import math
 
-    value = declare(node, name, float(default), description, any_type=True)
     number = isinstance(value, (int, float)) and not isinstance(value, bool)
     if not number or not math.isfinite(value) or (positive and value <= 0):
         need = "a positive number" if positive else "a finite number"
-        raise StartupError(f"parameter {name} must be {need}, got {value!r}")
-    return float(value)
+        return f"parameter {name} must be {need}, got {value!r}"
+    return ""

@@ -23,6 +23,7 @@ from evorbc_ros.nodes.common import (
     StartupError,
     declare,
     finite_parameter,
+    logged_startup,
     run_node,
     sensor_layout_parameter,
     vector_message,
@@ -34,18 +35,19 @@ class LaserSensorNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__("laser_sensor", **kwargs)
-        layout = sensor_layout_parameter(self)
-        if layout.rangefinders is None:
-            raise StartupError("parameter sensor_layout: the layout has no rangefinders")
-        pose = LaserPose(
-            finite_parameter(self, "laser_x", 0.0, "scanner position on the robot, x (m)"),
-            finite_parameter(self, "laser_y", 0.0, "scanner position on the robot, y (m)"),
-            finite_parameter(self, "laser_yaw", 0.0, "scanner yaw in the robot frame (rad)"),
-        )
-        self.scan_topic = declare(self, "scan_topic", "scan", "input LaserScan topic")
-        out_topic = declare(
-            self, "output_topic", "evorbc/rangefinders", "output topic (Float64MultiArray)"
-        )
+        with logged_startup(self):
+            layout = sensor_layout_parameter(self)
+            if layout.rangefinders is None:
+                raise StartupError("parameter sensor_layout: the layout has no rangefinders")
+            pose = LaserPose(
+                finite_parameter(self, "laser_x", 0.0, "scanner position on the robot, x (m)"),
+                finite_parameter(self, "laser_y", 0.0, "scanner position on the robot, y (m)"),
+                finite_parameter(self, "laser_yaw", 0.0, "scanner yaw in the robot frame (rad)"),
+            )
+            self.scan_topic = declare(self, "scan_topic", "scan", "input LaserScan topic")
+            out_topic = declare(
+                self, "output_topic", "evorbc/rangefinders", "output topic (Float64MultiArray)"
+            )
         self.converter = LaserToRangefinders(layout.rangefinders, pose)
         n = len(layout.rangefinders.angles)
         self.names = layout.input_names()[:n]

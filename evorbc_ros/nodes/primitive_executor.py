@@ -17,6 +17,12 @@ A command goes out at once for every new primitive, and again whenever 1.5 perio
 the primitive or a sensor input is older than ``stale_timeout`` (0.3 s) the executor
 stops the robot within one cycle (4WS: zero wheel speed, steering held; hexapod: every
 joint held at its last target), and resumes when they return.
+
+Before the first message on ``evorbc/primitive`` nothing is published, so the executor
+does not fight another node (teleop) on the same controllers; ``zero_before_first_primitive``
+makes a 4WS executor send zero commands every period instead. A primitive labelled with
+another robot's parameter names is refused and logged as an error. ``wheel_radius`` is
+applied live (``ros2 param set``, validated); the other parameters are read-only.
 """
 
 from __future__ import annotations
@@ -24,7 +30,9 @@ from __future__ import annotations
 import sys
 
 from builtin_interfaces.msg import Duration
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
@@ -33,17 +41,18 @@ from evorbc_ros.hexapod_executor import HexapodExecutor, JointTargets
 from evorbc_ros.laser import InputError
 from evorbc_ros.nodes.common import (
     RELIABLE,
+    ROBOTS,
     StartupError,
     declare,
     finite_parameter,
+    finite_problem,
+    logged_startup,
     now_seconds,
     run_node,
     vector_message,
 )
 from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES, FourWSGeometry
-from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES, SERVO_RATE
-
-ROBOTS = (*ROBOT_TYPES, HEXAPOD)
+from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES, SERVO_RATE, parameter_specs
 
 
 class PrimitiveExecutorNode(Node):
@@ -51,50 +60,71 @@ class PrimitiveExecutorNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__("primitive_executor", **kwargs)
-        robot = declare(self, "robot", "4ws-5", f"robot type: {', '.join(ROBOTS)}")
-        if robot not in ROBOTS:
-            raise StartupError(f"parameter robot must be one of {', '.join(ROBOTS)}, got {robot!r}")
-        self.wheel_radius = finite_parameter(
-            self, "wheel_radius", 0.02, "wheel radius (m), for wheel velocities", positive=True
-        )
-        self.period = finite_parameter(self, "period", 0.1, "command period (s)", positive=True)
-        stale = finite_parameter(
-            self, "stale_timeout", 0.3, "stop when an input is older than this (s)", positive=True
-        )
-        primitive_topic = declare(
-            self, "primitive_topic", "evorbc/primitive", "primitive genes (Float64MultiArray)"
-        )
-        inputs = declare(
-            self,
-            "input_topics",
-            ["evorbc/rangefinders", "evorbc/goal_sectors"],
-            "sensor topics whose silence stops the robot",
-        )
-        steering_topic = declare(
-            self,
-            "steering_topic",
-            "steering_position_controller/commands",
-            "steering angles (Float64MultiArray, rad)",
-        )
-        wheel_topic = declare(
-            self,
-            "wheel_topic",
-            "wheel_velocity_controller/commands",
-            "wheel velocities (Float64MultiArray, rad/s)",
-        )
-        trajectory_topic = declare(
-            self,
-            "trajectory_topic",
-            "joint_trajectory_controller/joint_trajectory",
-            "hexapod joint targets (JointTrajectory, rad)",
-        )
-        rate = finite_parameter(
-            self,
-            "trajectory_rate",
-            SERVO_RATE,
-            "hexapod trajectory points per second (the simulation's physics rate)",
-            positive=True,
-        )
+        with logged_startup(self):
+            robot = declare(self, "robot", "4ws-5", f"robot type: {', '.join(ROBOTS)}")
+            if robot not in ROBOTS:
+                raise StartupError(
+                    f"parameter robot must be one of {', '.join(ROBOTS)}, got {robot!r}"
+                )
+            self.wheel_radius = finite_parameter(
+                self,
+                "wheel_radius",
+                0.02,
+                "wheel radius (m), for wheel velocities; applied live",
+                positive=True,
+                live=True,
+            )
+            self.period = finite_parameter(self, "period", 0.1, "command period (s)", positive=True)
+            stale = finite_parameter(
+                self,
+                "stale_timeout",
+                0.3,
+                "stop when an input is older than this (s)",
+                positive=True,
+            )
+            self.zero_before_primitive = declare(
+                self,
+                "zero_before_first_primitive",
+                False,
+                "4WS: send zero commands every period until the first primitive arrives "
+                "(false: send nothing, so another node may drive the robot)",
+            )
+            primitive_topic = declare(
+                self, "primitive_topic", "evorbc/primitive", "primitive genes (Float64MultiArray)"
+            )
+            inputs = declare(
+                self,
+                "input_topics",
+                ["evorbc/rangefinders", "evorbc/goal_sectors"],
+                "sensor topics whose silence stops the robot",
+            )
+            steering_topic = declare(
+                self,
+                "steering_topic",
+                "steering_position_controller/commands",
+                "steering angles (Float64MultiArray, rad)",
+            )
+            wheel_topic = declare(
+                self,
+                "wheel_topic",
+                "wheel_velocity_controller/commands",
+                "wheel velocities (Float64MultiArray, rad/s)",
+            )
+            trajectory_topic = declare(
+                self,
+                "trajectory_topic",
+                "joint_trajectory_controller/joint_trajectory",
+                "hexapod joint targets (JointTrajectory, rad)",
+            )
+            rate = finite_parameter(
+                self,
+                "trajectory_rate",
+                SERVO_RATE,
+                "hexapod trajectory points per second (the simulation's physics rate)",
+                positive=True,
+            )
+        self.robot = robot
+        self.parameter_names = robot_parameter_names(robot)
         self.primitive_topic = primitive_topic
         if robot == HEXAPOD:
             self.logic = HexapodExecutor(list(inputs), stale, rate)
@@ -106,7 +136,7 @@ class PrimitiveExecutorNode(Node):
             self.wheel_pub = self.create_publisher(Float64MultiArray, wheel_topic, RELIABLE)
         self.subs = [
             self.create_subscription(
-                Float64MultiArray, primitive_topic, self.on_primitive, RELIABLE
+                Float64MultiArray, primitive_topic, self.on_primitive_message, RELIABLE
             )
         ]
         self.subs += [
@@ -117,7 +147,32 @@ class PrimitiveExecutorNode(Node):
         ]
         self.last_publish = -float("inf")
         self.stopped_reason = ""
+        self.primitive_seen = False  # nothing is published before the arbitrator speaks
+        self.add_on_set_parameters_callback(self.on_set_parameters)
         self.timer = self.create_timer(self.period, self.on_timer)
+
+    def on_set_parameters(self, params: list[Parameter]) -> SetParametersResult:
+        """Apply a valid ``wheel_radius`` at once (the others are read-only)."""
+        for p in params:
+            if p.name == "wheel_radius":
+                problem = finite_problem(p.name, p.value, positive=True)
+                if problem:
+                    return SetParametersResult(successful=False, reason=problem)
+        for p in params:
+            if p.name == "wheel_radius":
+                self.wheel_radius = float(p.value)
+        return SetParametersResult(successful=True)
+
+    def on_primitive_message(self, msg: Float64MultiArray) -> None:
+        """Refuse a primitive labelled for another robot; otherwise run it."""
+        problem = primitive_mismatch(msg, self.robot, self.parameter_names)
+        if problem:
+            self.get_logger().error(
+                f"{self.primitive_topic}: refused {problem}", throttle_duration_sec=2.0
+            )
+            return
+        self.primitive_seen = True
+        self.on_primitive(msg)
 
     def on_primitive(self, msg: Float64MultiArray) -> None:
         """Run a new primitive at once."""
@@ -142,6 +197,8 @@ class PrimitiveExecutorNode(Node):
 
     def on_timer(self) -> None:
         """Stop on stale inputs; otherwise keep commands flowing at least every period."""
+        if not (self.primitive_seen or self.zero_before_primitive):
+            return  # never commanded: leave the controllers to whoever drives them (teleop)
         now = now_seconds(self)
         command = self.logic.command(now)
         if command.stopped or now - self.last_publish > 1.5 * self.period:
@@ -171,6 +228,35 @@ class PrimitiveExecutorNode(Node):
                 command.wheel_velocities(self.wheel_radius), [f"{w}_wheel" for w in WHEEL_NAMES]
             )
         )
+
+
+def robot_parameter_names(robot: str) -> list[str]:
+    """The names of ``robot``'s primitive parameters, as the arbitrator labels its genes."""
+    if robot == HEXAPOD:
+        return [p.name for p in parameter_specs()]
+    return list(ROBOT_TYPES[robot].parameter_names)
+
+
+def primitive_mismatch(msg: Float64MultiArray, robot: str, names: list[str]) -> str:
+    """Why a labelled primitive is not for ``robot`` ("" if it is, or carries no label).
+
+    The arbitrator labels the genes with its repertoire's parameter names. Two robots can
+    have as many genes and different meanings (2ws-3 and 4ws-3), so the count alone
+    would not catch a controller for another robot.
+    """
+    label = msg.layout.dim[0].label if msg.layout.dim else ""
+    got = label.split(",") if label else []
+    if not got or not msg.data or got == names:
+        return ""
+    other = next((r for r in ROBOTS if robot_parameter_names(r) == got), None)
+
+    def listed(n: list[str]) -> str:
+        return ", ".join(n) if len(n) <= 6 else f"{len(n)} parameters"
+
+    return (
+        f"{'a ' + other if other else 'a'} primitive ({listed(got)}): this executor drives "
+        f"a {robot} ({listed(names)}); is the arbitrator for another robot?"
+    )
 
 
 def trajectory_message(command: JointTargets) -> JointTrajectory:

@@ -1,10 +1,16 @@
 """``radar_sensor``: robot pose and goal -> goal-sector (4WS) or goal-bearing readings.
 
 Subscribes ``odom`` (nav_msgs/Odometry, sensor-data QoS) and ``goal``
-(geometry_msgs/PointStamped, or PoseStamped with ``goal_type: pose``; latched); publishes
+(geometry_msgs/PointStamped, or PoseStamped with ``goal_type: pose``); publishes
 ``evorbc/goal_sectors`` (std_msgs/Float64MultiArray, reliable) on every odometry message
 once a goal is known. The goal must be in the odometry's frame (no tf here); messages with
 NaN poses or another frame are logged and skipped.
+
+The goal is subscribed twice, with one callback: reliable transient-local, so a latched
+goal published before this node started still arrives, and reliable volatile, because a
+transient-local subscription never matches a volatile publisher (RViz's goal tool,
+``ros2 topic pub``). A goal that arrives on both is simply taken twice. RViz's goal tool
+publishes a PoseStamped on ``/goal_pose``: ``-p goal_type:=pose -r goal:=/goal_pose``.
 """
 
 from __future__ import annotations
@@ -13,6 +19,7 @@ import sys
 
 from geometry_msgs.msg import PointStamped, PoseStamped
 from nav_msgs.msg import Odometry
+from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
 from std_msgs.msg import Float64MultiArray
 
@@ -24,6 +31,7 @@ from evorbc_ros.nodes.common import (
     SENSOR_DATA,
     StartupError,
     declare,
+    logged_startup,
     run_node,
     sensor_layout_parameter,
     vector_message,
@@ -35,23 +43,36 @@ class RadarSensorNode(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__("radar_sensor", **kwargs)
-        layout = sensor_layout_parameter(self)
-        try:
-            self.inputs = GoalInputs(layout)
-        except ValueError as e:
-            raise StartupError(f"parameter sensor_layout: {e}") from None
-        self.odom_topic = declare(self, "odom_topic", "odom", "input Odometry topic")
-        self.goal_topic = declare(self, "goal_topic", "goal", "goal topic (latched)")
-        goal_type = declare(self, "goal_type", "point", "goal message type: point or pose")
-        if goal_type not in ("point", "pose"):
-            raise StartupError(f"parameter goal_type must be 'point' or 'pose', got {goal_type!r}")
-        out_topic = declare(
-            self, "output_topic", "evorbc/goal_sectors", "output topic (Float64MultiArray)"
-        )
+        with logged_startup(self):
+            layout = sensor_layout_parameter(self)
+            try:
+                self.inputs = GoalInputs(layout)
+            except ValueError as e:
+                raise StartupError(f"parameter sensor_layout: {e}") from None
+            self.odom_topic = declare(self, "odom_topic", "odom", "input Odometry topic")
+            self.goal_topic = declare(
+                self, "goal_topic", "goal", "goal topic (latched or volatile publishers)"
+            )
+            goal_type = declare(self, "goal_type", "point", "goal message type: point or pose")
+            if goal_type not in ("point", "pose"):
+                raise StartupError(
+                    f"parameter goal_type must be 'point' or 'pose', got {goal_type!r}"
+                )
+            out_topic = declare(
+                self, "output_topic", "evorbc/goal_sectors", "output topic (Float64MultiArray)"
+            )
         self.goal: tuple[float, float, str] | None = None
         self.pub = self.create_publisher(Float64MultiArray, out_topic, RELIABLE)
         msg_type = PointStamped if goal_type == "point" else PoseStamped
-        self.goal_sub = self.create_subscription(msg_type, self.goal_topic, self.on_goal, LATCHED)
+        # A volatile publisher is "incompatible" with the latched subscription by design;
+        # the volatile one takes its goals, and reports any real mismatch (best effort).
+        quiet = SubscriptionEventCallbacks(incompatible_qos=lambda info: None)
+        self.goal_subs = [
+            self.create_subscription(
+                msg_type, self.goal_topic, self.on_goal, LATCHED, event_callbacks=quiet
+            ),
+            self.create_subscription(msg_type, self.goal_topic, self.on_goal, RELIABLE),
+        ]
         self.odom_sub = self.create_subscription(
             Odometry, self.odom_topic, self.on_odom, SENSOR_DATA
         )

@@ -1,0 +1,237 @@
+"""The simulated graph as data: which nodes, with which parameters, for which robot.
+
+One description serves both ways of bringing the graph up: ``evorbc-sim``
+(:mod:`sim_bridge.bringup`, the nodes as plain processes) and ``ros2 launch evorbc_ros
+sim.launch.py`` (a thin wrapper over :func:`graph_from_arguments`). It imports neither
+rclpy nor ``launch``, so the launch logic is tested wherever the project's tests run
+(DESIGN.md section 10).
+
+Both fill in the same defaults: the robot's shipped controller when no arbitrator is given
+(none for a 4WS type other than 4ws-5: the arbitrator node then refuses to start and says
+how to make one), the robot's maze, simulated time for the four evorbc nodes, the
+parameter files ``config/ros/*.yaml`` under every node, and the ``robot`` parameter on the
+arbitrator, which refuses a controller for another robot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from evorbc_ros.config import ConfigError, config_dir
+from evorbc_ros.defaults import default_arbitrator, shipped_robots
+
+#: Robot types of the simulation (the 4WS types and the hexapod).
+SIM_ROBOTS = ("2ws-2", "2ws-3", "4ws-3", "4ws-5", "hexapod")
+MODES = ("lockstep", "realtime")
+
+
+@dataclass(frozen=True)
+class Argument:
+    """A launch argument: name, default (text, as ``name:=value`` gives it) and help."""
+
+    name: str
+    default: str
+    description: str
+
+
+#: The arguments of ``sim.launch.py`` (``ros2 launch evorbc_ros sim.launch.py --show-args``).
+ARGUMENTS = (
+    Argument(
+        "robot",
+        "4ws-5",
+        f"robot type: {', '.join(SIM_ROBOTS)}; the arbitrator refuses a controller for "
+        "another robot",
+    ),
+    Argument(
+        "maze",
+        "",
+        "maze name (obstacle, zigzag, baffles, corridors, gaps, hexapod) or maze YAML file; "
+        "empty: obstacle, or hexapod for the hexapod",
+    ),
+    Argument(
+        "mode", "lockstep", "lockstep (deterministic, as fast as the graph) or realtime (10 Hz)"
+    ),
+    Argument("gui", "false", "open the PyBullet window (true or false)"),
+    Argument(
+        "arbitrator",
+        "",
+        "arbitrator file (JSON); empty: the one shipped for robot (4ws-5 and hexapod ship one)",
+    ),
+    Argument(
+        "repertoire",
+        "",
+        "repertoire file (JSON); empty: the one shipped for the arbitrator's robot",
+    ),
+    Argument("start", "nominal", "start pose: nominal, random, or 'x,y,heading_deg'"),
+    Argument("seed", "0", "seed of a random start (integer >= 0)"),
+    Argument(
+        "namespace",
+        "",
+        "namespace of every node and topic (e.g. robot1); /clock stays global",
+    ),
+)
+
+
+@dataclass(frozen=True)
+class NodeSpec:
+    """One node of the graph.
+
+    Attributes:
+        name: node name, and its executable in ``lib/<package>/`` (``ros2 run``).
+        package: ``evorbc_ros`` or ``sim_bridge``.
+        module: the module ``python -m`` runs (``evorbc-sim``).
+        param_file: the shipped parameter file applied first (``config/ros/``).
+        parameters: overrides on top of it (empty values are left out: every empty
+            default means "none", and the file may set one).
+        required: the graph is over when this node exits, whatever its status.
+    """
+
+    name: str
+    package: str
+    module: str
+    param_file: Path
+    parameters: dict = field(default_factory=dict)
+    required: bool = False
+
+
+@dataclass(frozen=True)
+class SimGraph:
+    """The five nodes of one simulated run, and the namespace they run in ("" for none)."""
+
+    nodes: tuple[NodeSpec, ...]
+    namespace: str = ""
+
+    def node(self, name: str) -> NodeSpec:
+        """The node called ``name``."""
+        return next(n for n in self.nodes if n.name == name)
+
+
+def shipped_arbitrator(robot: str) -> str:
+    """The shipped arbitrator file for ``robot``, or "" if none ships for it."""
+    return str(default_arbitrator(robot)) if robot in shipped_robots() else ""
+
+
+def default_maze(robot: str) -> str:
+    """The maze a robot runs in when none is named: obstacle (4WS) or hexapod."""
+    return "hexapod" if robot == "hexapod" else "obstacle"
+
+
+def sim_graph(
+    robot: str = "4ws-5",
+    maze: str = "",
+    mode: str = "lockstep",
+    gui: bool = False,
+    arbitrator: str = "",
+    repertoire: str = "",
+    start: str = "nominal",
+    seed: int = 0,
+    namespace: str = "",
+    result_file: str = "",
+    record_file: str = "",
+) -> SimGraph:
+    """The graph that runs ``arbitrator`` (default: the one shipped for ``robot``) in a maze.
+
+    Raises:
+        ConfigError: an unknown robot or mode (one line naming the argument).
+    """
+    if robot not in SIM_ROBOTS:
+        raise ConfigError(f"robot must be one of {', '.join(SIM_ROBOTS)}, got {robot!r}")
+    if mode not in MODES:
+        raise ConfigError(f"mode must be lockstep or realtime, got {mode!r}")
+    arbitrator = arbitrator or shipped_arbitrator(robot)
+    nodes_file = config_dir() / "ros" / "evorbc_nodes.yaml"
+    sim_time = {"use_sim_time": True}
+
+    def evorbc(name: str, **params) -> NodeSpec:
+        return NodeSpec(
+            name, "evorbc_ros", f"evorbc_ros.nodes.{name}", nodes_file, _given(sim_time | params)
+        )
+
+    return SimGraph(
+        (
+            evorbc("laser_sensor", sensor_layout=arbitrator),
+            evorbc("radar_sensor", sensor_layout=arbitrator),
+            evorbc(
+                "arbitrator",
+                arbitrator=arbitrator,
+                repertoire=repertoire,
+                robot=robot,
+                record_file=record_file,
+            ),
+            evorbc("primitive_executor", robot=robot),
+            NodeSpec(
+                "sim_bridge",
+                "sim_bridge",
+                "sim_bridge.bridge_node",
+                config_dir() / "ros" / "sim_bridge.yaml",
+                _given(
+                    {
+                        "robot": robot,
+                        "maze": maze or default_maze(robot),
+                        "mode": mode,
+                        "gui": gui,
+                        "start": start,
+                        "seed": seed,
+                        "result_file": result_file,
+                    }
+                ),
+                required=True,
+            ),
+        ),
+        namespace.strip("/"),
+    )
+
+
+def _given(params: dict) -> dict:
+    """``params`` without empty strings (rcl cannot parse ``-p name:=``)."""
+    return {k: v for k, v in params.items() if v != ""}
+
+
+def graph_from_arguments(values: dict[str, str]) -> SimGraph:
+    """The graph for launch arguments given as text (``name:=value``; missing: default).
+
+    Raises:
+        ConfigError: one line naming the argument and what it takes.
+    """
+    given = {a.name: values.get(a.name, a.default) for a in ARGUMENTS}
+    gui = given["gui"].strip().lower()
+    if gui not in ("true", "false"):
+        raise ConfigError(f"argument gui must be true or false, got {given['gui']!r}")
+    try:
+        seed = int(given["seed"])
+    except ValueError:
+        seed = -1
+    if seed < 0:
+        raise ConfigError(f"argument seed must be an integer >= 0, got {given['seed']!r}")
+    try:
+        return sim_graph(
+            robot=given["robot"],
+            maze=given["maze"],
+            mode=given["mode"],
+            gui=gui == "true",
+            arbitrator=given["arbitrator"],
+            repertoire=given["repertoire"],
+            start=given["start"],
+            seed=seed,
+            namespace=given["namespace"],
+        )
+    except ConfigError as e:
+        raise ConfigError(f"argument {e}") from None
+
+
+def exit_ends_graph(node: NodeSpec, returncode: int | None) -> str:
+    """Why the graph shuts down when ``node`` exits with ``returncode``; "" if it goes on.
+
+    The bridge's exit ends the episode, whatever its status; any other node failing
+    (non-zero status, or killed by a signal) leaves the graph useless: no command or no
+    sensor reading would ever come again.
+    """
+    if returncode is None:
+        return ""  # still running
+    if node.required:
+        how = "the episode is over" if returncode == 0 else f"status {returncode}"
+        return f"{node.name} exited ({how})"
+    if returncode != 0:
+        return f"{node.name} failed (status {returncode}); the graph cannot run without it"
+    return ""

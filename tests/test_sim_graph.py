@@ -1,0 +1,282 @@
+"""The simulated graph's description (sim_bridge.graph), shared by evorbc-sim and the
+launch file: which nodes, with which parameters, for which robot, and when the graph ends.
+The launch file is run against stand-ins for ``launch`` and ``launch_ros``, so this runs
+where ROS 2's launch is not installed; the real one is tried in test_ros_packaging."""
+
+import runpy
+import sys
+import types
+from pathlib import Path
+
+import pytest
+
+from evorbc_ros.config import ConfigError, config_dir
+from evorbc_ros.defaults import default_arbitrator
+from sim_bridge import bringup
+from sim_bridge.graph import (
+    ARGUMENTS,
+    exit_ends_graph,
+    graph_from_arguments,
+    sim_graph,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+NODES_FILE = config_dir() / "ros" / "evorbc_nodes.yaml"
+BRIDGE_FILE = config_dir() / "ros" / "sim_bridge.yaml"
+
+
+def params(graph):
+    return {n.name: n.parameters for n in graph.nodes}
+
+
+def test_the_default_graph_runs_the_shipped_4ws_5_controller_in_obstacle():
+    graph = sim_graph()
+    arb = str(default_arbitrator("4ws-5"))
+    assert [n.name for n in graph.nodes] == [
+        "laser_sensor",
+        "radar_sensor",
+        "arbitrator",
+        "primitive_executor",
+        "sim_bridge",
+    ]
+    assert params(graph) == {
+        "laser_sensor": {"use_sim_time": True, "sensor_layout": arb},
+        "radar_sensor": {"use_sim_time": True, "sensor_layout": arb},
+        "arbitrator": {"use_sim_time": True, "arbitrator": arb, "robot": "4ws-5"},
+        "primitive_executor": {"use_sim_time": True, "robot": "4ws-5"},
+        "sim_bridge": {
+            "robot": "4ws-5",
+            "maze": "obstacle",
+            "mode": "lockstep",
+            "gui": False,
+            "start": "nominal",
+            "seed": 0,
+        },
+    }
+    assert {n.name: n.param_file for n in graph.nodes} == {
+        **dict.fromkeys(["laser_sensor", "radar_sensor", "arbitrator"], NODES_FILE),
+        "primitive_executor": NODES_FILE,
+        "sim_bridge": BRIDGE_FILE,
+    }
+    assert [n.name for n in graph.nodes if n.required] == ["sim_bridge"]
+    assert {n.package for n in graph.nodes} == {"evorbc_ros", "sim_bridge"}
+    assert graph.namespace == ""
+
+
+def test_the_hexapod_gets_its_shipped_controller_and_maze():
+    p = params(sim_graph(robot="hexapod", namespace="/robot1/"))
+    arb = str(default_arbitrator("hexapod"))
+    assert p["arbitrator"]["arbitrator"] == arb and p["arbitrator"]["robot"] == "hexapod"
+    assert p["laser_sensor"]["sensor_layout"] == arb
+    assert p["sim_bridge"]["maze"] == "hexapod" and p["sim_bridge"]["robot"] == "hexapod"
+    assert p["primitive_executor"]["robot"] == "hexapod"
+    assert sim_graph(robot="hexapod", namespace="/robot1/").namespace == "robot1"
+
+
+def test_a_robot_without_a_shipped_controller_leaves_the_arbitrator_to_refuse():
+    p = params(sim_graph(robot="4ws-3"))
+    # No file is filled in; the arbitrator node, told the robot, says none ships for it.
+    assert "arbitrator" not in p["arbitrator"] and p["arbitrator"]["robot"] == "4ws-3"
+    assert p["primitive_executor"]["robot"] == "4ws-3"
+    given = params(sim_graph(robot="4ws-3", arbitrator="mine.json", repertoire="r.json"))
+    assert given["arbitrator"]["arbitrator"] == "mine.json"
+    assert given["arbitrator"]["repertoire"] == "r.json"
+
+
+def test_launch_arguments_are_parsed_with_one_line_errors():
+    assert graph_from_arguments({}) == sim_graph()
+    graph = graph_from_arguments(
+        {"gui": "True", "seed": "7", "mode": "realtime", "maze": "zigzag", "namespace": "r1"}
+    )
+    assert params(graph)["sim_bridge"] == {
+        "robot": "4ws-5",
+        "maze": "zigzag",
+        "mode": "realtime",
+        "gui": True,
+        "start": "nominal",
+        "seed": 7,
+    }
+    assert graph.namespace == "r1"
+    for values, message in [
+        ({"robot": "tank"}, "argument robot must be one of 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod"),
+        ({"mode": "fast"}, "argument mode must be lockstep or realtime, got 'fast'"),
+        ({"gui": "yes"}, "argument gui must be true or false, got 'yes'"),
+        ({"seed": "-1"}, "argument seed must be an integer >= 0, got '-1'"),
+        ({"seed": "x"}, "argument seed must be an integer >= 0, got 'x'"),
+    ]:
+        with pytest.raises(ConfigError) as info:
+            graph_from_arguments(values)
+        assert str(info.value).startswith(message)
+
+
+def test_the_graph_ends_with_the_bridge_or_when_any_node_fails():
+    graph = sim_graph()
+    bridge, laser = graph.node("sim_bridge"), graph.node("laser_sensor")
+    assert exit_ends_graph(bridge, 0) == "sim_bridge exited (the episode is over)"
+    assert exit_ends_graph(bridge, 2) == "sim_bridge exited (status 2)"
+    assert exit_ends_graph(laser, 0) == ""  # stopped with the rest
+    assert exit_ends_graph(laser, None) == ""  # still running
+    assert exit_ends_graph(laser, 2).startswith("laser_sensor failed (status 2)")
+    assert exit_ends_graph(laser, -11).startswith("laser_sensor failed (status -11)")
+
+
+class Recorded:
+    """A stand-in for a launch class: keeps its arguments."""
+
+    def __init__(self, *args, **kwargs):
+        self.args, self.kwargs = args, kwargs
+
+
+def fake_launch(monkeypatch, values):
+    """``launch`` and ``launch_ros`` stand-ins; LaunchConfiguration reads ``values``."""
+
+    class LaunchConfiguration(Recorded):
+        def perform(self, context):
+            return values.get(self.args[0], context[self.args[0]])
+
+    modules = {
+        "launch": {"LaunchDescription": Recorded},
+        "launch.actions": {
+            "DeclareLaunchArgument": Recorded,
+            "OpaqueFunction": Recorded,
+            "Shutdown": Recorded,
+        },
+        "launch.substitutions": {"LaunchConfiguration": LaunchConfiguration},
+        "launch_ros": {},
+        "launch_ros.actions": {"Node": Recorded},
+    }
+    for name, attrs in modules.items():
+        module = types.ModuleType(name)
+        module.__dict__.update(attrs)
+        monkeypatch.setitem(sys.modules, name, module)
+
+
+def launch_nodes(monkeypatch, **values):
+    fake_launch(monkeypatch, values)
+    description = runpy.run_path(str(ROOT / "launch" / "sim.launch.py"))[
+        "generate_launch_description"
+    ]()
+    entities = description.args[0]
+    declared = [e for e in entities if "default_value" in e.kwargs]
+    defaults = {e.args[0]: e.kwargs["default_value"] for e in declared}
+    opaque = entities[-1].kwargs["function"]
+    return declared, opaque(defaults)
+
+
+def test_the_launch_file_declares_every_argument_with_a_description(monkeypatch):
+    declared, _ = launch_nodes(monkeypatch)
+    assert [(e.args[0], e.kwargs["default_value"]) for e in declared] == [
+        (a.name, a.default) for a in ARGUMENTS
+    ]
+    assert all(len(e.kwargs["description"]) > 20 for e in declared)
+    assert "namespace" in [e.args[0] for e in declared]
+
+
+def test_the_launch_file_starts_the_shared_graph(monkeypatch):
+    _, nodes = launch_nodes(monkeypatch, robot="hexapod", namespace="robot1")
+    graph = sim_graph(robot="hexapod", namespace="robot1")
+    assert [n.kwargs["executable"] for n in nodes] == [n.name for n in graph.nodes]
+    for node, spec in zip(nodes, graph.nodes, strict=True):
+        assert node.kwargs["package"] == spec.package
+        assert node.kwargs["namespace"] == "robot1"
+        assert node.kwargs["parameters"] == [str(spec.param_file), spec.parameters]
+
+
+def test_the_launch_file_shuts_the_graph_down_as_the_shared_rule_says(monkeypatch):
+    _, nodes = launch_nodes(monkeypatch)
+    on_exit = {n.kwargs["executable"]: n.kwargs["on_exit"] for n in nodes}
+
+    def exited(name, code):
+        return on_exit[name](types.SimpleNamespace(returncode=code), None)
+
+    (shutdown,) = exited("sim_bridge", 0)
+    assert shutdown.kwargs["reason"] == "sim_bridge exited (the episode is over)"
+    assert exited("laser_sensor", 0) is None
+    (shutdown,) = exited("arbitrator", 2)
+    assert shutdown.kwargs["reason"].startswith("arbitrator failed (status 2)")
+
+
+def test_evorbc_sim_starts_the_same_graph_with_the_parameter_files(monkeypatch):
+    started = []
+
+    class FakeGraph(bringup.Graph):
+        def start(self, spec, namespace=""):
+            started.append(bringup.node_command(spec.module, spec.parameters, spec.param_file))
+
+    args = bringup.parse_args(["--maze", "zigzag", "--seed", "3", "--start", "random"])
+    bringup.start_graph(FakeGraph({}, True), args, "4ws-5", "a.json", "out.json")
+    expected = sim_graph(
+        maze="zigzag", seed=3, start="random", arbitrator="a.json", result_file="out.json"
+    )
+    assert started == [
+        bringup.node_command(n.module, n.parameters, n.param_file) for n in expected.nodes
+    ]
+    cmd = started[2]
+    assert cmd[cmd.index("--params-file") + 1] == str(NODES_FILE)
+    assert "robot:=4ws-5" in cmd and "arbitrator:=a.json" in cmd
+
+
+def test_node_commands_carry_the_file_the_namespace_and_the_overrides():
+    cmd = bringup.node_command("m", {"a": True, "b": "", "c": 1.5}, NODES_FILE, "robot1")
+    assert cmd[1:] == [
+        "-m",
+        "m",
+        "--ros-args",
+        "--params-file",
+        str(NODES_FILE),
+        "-r",
+        "__ns:=/robot1",
+        "-p",
+        "a:=true",
+        "-p",
+        "c:=1.5",
+    ]
+
+
+# -- evorbc-sim's own errors, before any node starts ---------------------------------------
+
+
+@pytest.fixture
+def no_graph(monkeypatch):
+    def refuse(*args, **kwargs):
+        raise AssertionError("a node was started")
+
+    monkeypatch.setattr(bringup, "start_graph", refuse)
+
+
+def run_sim(capsys, *argv):
+    code = bringup.main(list(argv))
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "Traceback" not in "\n".join(err)
+    return code, err
+
+
+def test_a_mistyped_robot_is_one_line(capsys):
+    with pytest.raises(SystemExit) as info:
+        bringup.main(["--robot", "4ws5"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert info.value.code == 2
+    assert err == [
+        "evorbc-sim: error: argument --robot: invalid choice: '4ws5' (choose from '2ws-2', "
+        "'2ws-3', '4ws-3', '4ws-5', 'hexapod') (see evorbc-sim --help)"
+    ]
+
+
+def test_a_robot_without_a_shipped_controller_says_how_to_make_one(capsys, no_graph):
+    code, err = run_sim(capsys, "--robot", "2ws-2")
+    assert code == 1
+    assert err == [
+        "evorbc-sim: error: no controller ships for robot 2ws-2 (only for 4ws-5 and hexapod); "
+        "make one with 'evorbc-evolve repertoire --robot 2ws-2 --seed 1 --out r.json' and "
+        "'evorbc-evolve arbitrator --repertoire r.json --seed 1 --out a.json', then run "
+        "'evorbc-sim --arbitrator a.json --repertoire r.json'"
+    ]
+
+
+def test_a_robot_that_does_not_fit_the_maze_is_not_blamed_on_start(capsys, no_graph):
+    code, err = run_sim(capsys, "--robot", "hexapod", "--maze", "zigzag")
+    assert code == 1 and len(err) == 1
+    assert err[0].startswith("evorbc-sim: error: robot hexapod does not fit maze zigzag: ")
+    assert "--start" not in err[0] and err[0].endswith("its maze is hexapod")
+    code, err = run_sim(capsys, "--robot", "hexapod", "--maze", "zigzag", "--start", "random")
+    assert err[0].startswith("evorbc-sim: error: robot hexapod does not fit maze zigzag: ")
