@@ -108,7 +108,7 @@ def main() -> int:
         if args.test:
             steps.append(("make test", [*ros, "make", "test"]))
         for k, (name, command) in enumerate(steps):
-            step(name, command, clone, env, logs / f"{k}-{command[-1]}.log")
+            step(name, command, clone, env, logs / f"{k}-{Path(command[-1]).name}.log")
             if k == 0:
                 size = folder_size(clone / ".venv")
                 print(f"{'.venv size':<34} {size / 1e9:8.2f} GB", flush=True)
