@@ -6,6 +6,7 @@ import signal
 import subprocess
 import sys
 import time
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -96,7 +97,9 @@ def test_nodes_refuse_bad_parameters_with_one_line(tmp_path):
 
 
 def test_evorbc_sim_stops_the_whole_graph_on_ctrl_c(tmp_path):
-    env = graph_env(164)
+    # A mark of this run's processes alone (another suite on the machine may use domain 164).
+    mark = f"EVORBC_TEST_RUN={uuid.uuid4().hex}"
+    env = {**graph_env(164), "EVORBC_TEST_RUN": mark.split("=", 1)[1]}
     proc = subprocess.Popen(
         [
             sys.executable,
@@ -132,7 +135,7 @@ def test_evorbc_sim_stops_the_whole_graph_on_ctrl_c(tmp_path):
     ), out
     assert "rcl" not in err and "Traceback" not in err and "Failed" not in err
     assert (tmp_path / "run.png").exists()
-    assert not processes_with_env("ROS_DOMAIN_ID=164"), "nodes outlived evorbc-sim"
+    assert not processes_with_env(mark), "nodes outlived evorbc-sim"
 
 
 def processes_with_env(entry: str) -> list[int]:
