@@ -54,6 +54,7 @@ from evorbc_ros.nodes.common import (
     init_ros,
     logged_startup,
     quiet_teardown,
+    running,
     stop_requested,
 )
 from evorbc_ros.robots.hexapod import HEXAPOD
@@ -270,7 +271,7 @@ class SimBridgeNode(Node):
     def spin_for(self, executor, seconds: float) -> None:
         """Process messages for ``seconds`` of wall time."""
         until = time.monotonic() + seconds
-        while time.monotonic() < until and rclpy.ok():
+        while time.monotonic() < until and running():
             executor.spin_once(timeout_sec=0.05)
 
     def wait_for_graph(self, executor) -> None:
@@ -280,7 +281,7 @@ class SimBridgeNode(Node):
         already seen it would then answer twice.
         """
         deadline = time.monotonic() + self.startup_timeout
-        while self.missing() and time.monotonic() < deadline and rclpy.ok():
+        while self.missing() and time.monotonic() < deadline and running():
             executor.spin_once(timeout_sec=0.05)
         if self.missing():
             self.get_logger().warning(f"starting without {', '.join(self.missing())}")
@@ -299,7 +300,7 @@ class SimBridgeNode(Node):
         """
         sent = checked = time.monotonic()
         node_left = False
-        while not all(self.fresh.values()) and rclpy.ok():
+        while not all(self.fresh.values()) and running():
             executor.spin_once(timeout_sec=0.01)
             now = time.monotonic()
             if now - checked > 0.1:
@@ -326,12 +327,12 @@ class SimBridgeNode(Node):
         try:
             self.wait_for_graph(executor)
             self.loop_start = time.monotonic()
-            while not self.world.status().done and rclpy.ok():
+            while not self.world.status().done and running():
                 self.fresh = dict.fromkeys(self.fresh, False)
                 self.publish_state()
                 self.wait_for_commands(executor)
                 self.advance()
-            if rclpy.ok():
+            if running():
                 self.publish_state()  # final state for listeners
         finally:
             executor.remove_node(self)
@@ -346,7 +347,7 @@ class SimBridgeNode(Node):
             self.loop_start = time.monotonic()
             self.publish_state()
             next_tick = time.monotonic() + period
-            while not self.world.status().done and rclpy.ok():
+            while not self.world.status().done and running():
                 executor.spin_once(timeout_sec=max(0.0, next_tick - time.monotonic()))
                 if time.monotonic() >= next_tick:
                     next_tick += period
@@ -411,7 +412,7 @@ def main(argv=None) -> int:
             node.run_lockstep()
         else:
             node.run_realtime()
-        result = node.finish(interrupted=not rclpy.ok())
+        result = node.finish(interrupted=stop_requested())
     except StartupError as e:
         if not e.logged:
             print(f"error: {e}", file=sys.stderr)

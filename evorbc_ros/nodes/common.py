@@ -88,46 +88,59 @@ _stopping = False
 def stop_on_first_signal() -> None:
     """Make SIGINT and SIGTERM stop the node once; later ones are ignored.
 
-    Call before ``rclpy.init``. rclpy's own handler then chains to this one: on the first
-    signal rclpy shuts the context down and wakes the executor, so ``spin`` and the
-    bridge's loops end by themselves; this handler only notes the stop. Raising
-    KeyboardInterrupt there instead would land anywhere, in a numba compiler callback or
-    in ``destroy_node``, and print a traceback. Only while rclpy's handler is not
-    installed (inside ``rclpy.init``) does the first signal raise KeyboardInterrupt.
-    ``ros2 launch`` run from a script sends a second SIGINT while the nodes shut down:
-    it is ignored.
+    The handler only notes the stop: the node's loop (:func:`spin_until_stopped`, the
+    bridge's loops) sees it within its wait timeout and ends, and only then are the nodes
+    destroyed and the context shut down. rclpy's own handlers are not installed
+    (``SignalHandlerOptions.NO`` in :func:`init_ros`): they shut the context down from
+    another thread at once, and a callback logging at that moment then fails to publish
+    to ``/rosout`` and rcl prints an error; raising KeyboardInterrupt instead would land
+    anywhere, in a numba compiler callback or in ``destroy_node``, and print a traceback.
+    ``ros2 launch`` run from a script sends a second SIGINT while the nodes shut down: it
+    is ignored.
     """
-    from rclpy.signals import SignalHandlerOptions, get_current_signal_handlers_options
 
     def on_signal(signum, frame) -> None:
         global _stopping
-        if _stopping:
-            return
         _stopping = True
-        if get_current_signal_handlers_options() == SignalHandlerOptions.NO:
-            raise KeyboardInterrupt  # rclpy is not listening yet: nothing else would stop
 
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
 
 
 def stop_requested() -> bool:
-    """True once SIGINT or SIGTERM arrived (see :func:`stop_on_first_signal`).
-
-    rclpy's signal thread shuts the context down at once, so a node still being built
-    then fails with "context is not valid": that is a stop, not an error.
-    """
+    """True once SIGINT or SIGTERM arrived (see :func:`stop_on_first_signal`)."""
     return _stopping
+
+
+def running() -> bool:
+    """True while no stop was requested and the ROS context is up."""
+    return not _stopping and rclpy.ok()
+
+
+#: Longest wait (s) of a node's loop: how late a node may notice a stop request.
+STOP_POLL = 0.1
+
+
+def spin_until_stopped(node: Node) -> None:
+    """Run ``node``'s callbacks until a signal asks the process to stop.
+
+    Waits are bounded by :data:`STOP_POLL`, because no rclpy signal handler wakes them.
+    """
+    executor = Executor(context=node.context)
+    executor.add_node(node)
+    try:
+        while running():
+            executor.spin_once(timeout_sec=STOP_POLL)
+    finally:
+        executor.remove_node(node)
+        executor.shutdown()
 
 
 def quiet_teardown() -> None:
     """Ignore SIGINT and SIGTERM from now on: the process is finishing anyway.
 
-    rclpy's signal thread shuts contexts down and triggers the executors' guard conditions
-    on every signal; a second signal while the node and executor are being destroyed would
-    touch objects being freed, so rclpy's handlers go first. The signals are then ignored
-    at the OS level: Python restores the default action of every signal it handled as it
-    exits, and a late SIGINT would then kill the process (status -2) after a clean stop.
+    Python restores the default action of every signal it handled as it exits, and a late
+    SIGINT would then kill the process (status -2) after a clean stop.
     """
     from rclpy.signals import uninstall_signal_handlers
 
@@ -173,34 +186,35 @@ def now_seconds(node: Node) -> float:
 
 
 class Executor(rclpy.executors.SingleThreadedExecutor):
-    """rclpy's single-threaded executor, safe to make while a signal stops the process.
+    """rclpy's single-threaded executor, safe to make if the context is already shut down.
 
-    Made just as the signal shuts the context down, its ``__init__`` fails; rclpy's
-    ``__del__`` then reads an attribute that was never set and prints a traceback. The
-    class attribute gives it one.
+    Its ``__init__`` then fails, and rclpy's ``__del__`` reads an attribute that was never
+    set and prints a traceback; the class attribute gives it one.
     """
 
     _sigint_gc = None
 
 
 def init_ros(argv: Sequence[str] | None) -> int | None:
-    """``rclpy.init`` after :func:`stop_on_first_signal`.
+    """``rclpy.init`` after :func:`stop_on_first_signal`, without rclpy's signal handlers.
 
     Returns:
         None to go on; otherwise the exit status: 2 after one line on bad arguments, 0 if
         a signal came first.
     """
+    from rclpy.signals import SignalHandlerOptions
+
     stop_on_first_signal()
     try:
-        rclpy.init(args=argv)
-    except KeyboardInterrupt:
-        quiet_teardown()
-        rclpy.try_shutdown()
-        return 0
+        rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     except Exception as e:  # rcl reports bad --ros-args as a generic RCLError
         first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
         print(f"error: cannot start: {first}", file=sys.stderr)
         return 2
+    if stop_requested():
+        quiet_teardown()
+        rclpy.try_shutdown()
+        return 0
     return None
 
 
@@ -216,7 +230,7 @@ def run_node(make: Callable[[], Node], argv: Sequence[str] | None = None) -> int
     node = None
     try:
         node = make()
-        rclpy.spin(node, Executor())
+        spin_until_stopped(node)
     except StartupError as e:
         if not e.logged:
             print(f"error: {e}", file=sys.stderr)
