@@ -174,6 +174,14 @@ def cmd_replay(args: argparse.Namespace) -> int:
         outcomes, result = replay(arb, task, starts, repertoire)
     finally:
         task.close()
+    for o in outcomes:
+        if o.stopped_cycles:
+            print(
+                f"evorbc-evolve: warning: {o.maze}: the network's outputs were not finite in "
+                f"{o.stopped_cycles} of {round(o.time / task.dt)} cycles; the robot stood still "
+                "in those (no primitive)",
+                file=sys.stderr,
+            )
     mean = float(np.mean([o.fitness for o in outcomes]))
     reached = sum(o.reached for o in outcomes)
     summary = summarise_outcomes(outcomes)
