@@ -139,6 +139,41 @@ def test_huge_but_finite_points_use_the_border_cell_in_python_and_compiled_code(
     assert choose_primitive(fn, lookup, 1e308, 0.5)[0] == lookup.nearest(1e300, 0.0)
 
 
+def test_python_and_compiled_networks_agree_when_values_overflow():
+    """NaN and infinity inside a network give the same outputs onboard and offline."""
+    from evorbc_ros.network import ConnectionSpec, NetworkSpec, NodeSpec
+    from offline_evolution.arbitrator.compiled import activate_packed, pack_networks
+
+    def node(key, activation, aggregation="sum", bias=0.0):
+        return NodeSpec(key, bias, 1.0, activation, aggregation)
+
+    spec = NetworkSpec(
+        input_keys=(-1, -2, -3),
+        output_keys=(0, 1),
+        nodes=(
+            node(5, "cube", bias=1e300),  # infinity
+            node(6, "identity"),  # infinity - infinity: NaN
+            node(0, "identity", "median"),  # the median of NaN and two inputs
+            node(1, "log", "max"),
+        ),
+        connections=(
+            ConnectionSpec(-1, 5, 1.0),
+            ConnectionSpec(5, 6, 1.0),
+            ConnectionSpec(5, 6, -1.0),
+            ConnectionSpec(-1, 0, 1.0),
+            ConnectionSpec(6, 0, 1.0),
+            ConnectionSpec(-2, 0, 1.0),
+            ConnectionSpec(6, 1, 1.0),
+            ConnectionSpec(-3, 1, 1.0),
+        ),
+    )
+    pack = pack_networks([spec])
+    for inputs in ([0.1, 0.5, 0.2], [0.9, 0.3, 0.0], [0.0, 0.0, 1.0]):
+        python = spec.compile().activate(inputs)
+        compiled = activate_packed(pack, 0, inputs)
+        np.testing.assert_array_equal(python, compiled)
+
+
 # -- onboard: the executor -----------------------------------------------------------------
 
 
