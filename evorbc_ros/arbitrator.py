@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.input_files import ARBITRATOR_LIMIT
 from evorbc_ros.json_files import load_json_file
 from evorbc_ros.mapping import MAPPINGS, MappingFunction, PrimitiveLookup, choose_primitive
 from evorbc_ros.network import NetworkError, NetworkSpec
@@ -96,7 +97,7 @@ class ArbitratorFile:
         Raises:
             ArbitratorError: one line naming the file and the problem.
         """
-        data = load_json_file(path, "arbitrator", ArbitratorError)
+        data = load_json_file(path, "arbitrator", ArbitratorError, ARBITRATOR_LIMIT)
         return cls.from_dict(data, str(path))
 
     @classmethod

@@ -22,6 +22,8 @@ from typing import Any
 
 import yaml
 
+from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular_text
+
 
 class ConfigError(ValueError):
     """A settings file or value is not valid; the message names the file and key."""
@@ -31,16 +33,12 @@ def load_yaml_mapping(path: str | os.PathLike) -> dict[str, Any]:
     """Read a YAML file whose top level is a mapping.
 
     Raises:
-        ConfigError: the file is missing, not YAML, or not a mapping.
+        ConfigError: the file is missing, not a regular file, too large, not UTF-8, not
+            YAML, or not a mapping.
 
     """
     source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError(f"{source}: no such settings file") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise ConfigError(f"{source}: cannot read ({e})") from None
+    text = read_regular_text(path, "settings", ConfigError, SETTINGS_LIMIT)
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as e:

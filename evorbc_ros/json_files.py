@@ -4,30 +4,29 @@ from __future__ import annotations
 
 import json
 import os
-from pathlib import Path
 from typing import Any
 
+from evorbc_ros.input_files import DATA_LIMIT, read_regular_text
 
-def load_json_file(path: str | os.PathLike, what: str, error: type[Exception]) -> Any:
+
+def load_json_file(
+    path: str | os.PathLike, what: str, error: type[Exception], limit: int = DATA_LIMIT
+) -> Any:
     """Parse the JSON file at ``path``.
 
     Args:
         what: what the file should be (``"repertoire"``), for the messages.
         error: the exception class to raise.
+        limit: the largest file (bytes) accepted for ``what``.
 
     Raises:
-        ``error``: missing, unreadable, not UTF-8, or truncated/corrupt (also absurdly
-        nested) JSON, in one line that starts with the path.
+        ``error``: missing, not a regular file, too large, unreadable, not UTF-8, or
+        truncated/corrupt (also absurdly nested) JSON, in one line that starts with the
+        path. Numbers beyond float range are refused where they are used (they load as
+        Python integers or infinity).
     """
     source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise error(f"{source}: no such {what} file") from None
-    except UnicodeDecodeError:
-        raise error(f"{source}: not a {what} file (not UTF-8 text)") from None
-    except OSError as e:
-        raise error(f"{source}: cannot read ({e.strerror})") from None
+    text = read_regular_text(path, what, error, limit)
     try:
         return json.loads(text)
     except RecursionError:

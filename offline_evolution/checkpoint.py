@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write
+from evorbc_ros.input_files import DATA_LIMIT, is_regular, read_regular
 from evorbc_ros.json_files import first_difference
 
 _HEADER = "__header__"
@@ -75,21 +76,28 @@ def _header(data, source: str) -> dict:
     return header
 
 
+def _not_ours(message: str) -> CheckpointError:
+    """The error for a file that is not recognisably a checkpoint: never to be deleted."""
+    return CheckpointError(message, discardable=False)
+
+
+def _read(path: str | os.PathLike) -> bytes:
+    """The bytes of a checkpoint file: a regular file of a sane size, else CheckpointError."""
+    return read_regular(path, "checkpoint", _not_ours, DATA_LIMIT)
+
+
 def _open(path: str | os.PathLike):
     """``np.load`` of a file that is an ``.npz`` archive, else CheckpointError."""
     source = str(path)
-    if not Path(path).exists():
-        raise CheckpointError(f"{source}: no such checkpoint", discardable=False)
-    if Path(path).is_dir():
-        raise CheckpointError(f"{source}: is a folder, expected a checkpoint", discardable=False)
+    data = io.BytesIO(_read(path))
     # Checked first: numpy reads any other file as a pickle and then complains about
     # allow_pickle, which says nothing useful about a JSON or text file.
-    if not zipfile.is_zipfile(path):
+    if not zipfile.is_zipfile(data):
         raise CheckpointError(
             f"{source}: not a checkpoint (not an .npz archive)", discardable=False
         )
     try:
-        return np.load(path, allow_pickle=False)
+        return np.load(data, allow_pickle=False)
     except _READ_ERRORS as e:
         raise CheckpointError(
             f"{source}: not a checkpoint ({_reason(e)})", discardable=False
@@ -121,10 +129,9 @@ def load_json_checkpoint(path: str | os.PathLike) -> dict:
         CheckpointError: unreadable, not JSON or not a JSON object (not ``discardable``).
 
     """
+    text = _read(path)
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
-    except OSError as e:
-        raise CheckpointError(f"{path}: cannot read ({e.strerror})", discardable=False) from None
+        data = json.loads(text.decode("utf-8"))
     except (UnicodeDecodeError, RecursionError, json.JSONDecodeError):
         raise CheckpointError(f"{path}: not a checkpoint (not JSON)", discardable=False) from None
     if not isinstance(data, dict):
@@ -134,6 +141,8 @@ def load_json_checkpoint(path: str | os.PathLike) -> dict:
 
 def checkpoint_kind(path: str | os.PathLike) -> str | None:
     """The ``kind`` a checkpoint (``.npz`` or JSON) declares; None for any other file."""
+    if not is_regular(path):
+        return None  # a folder, FIFO or device: opening it could block or never end
     try:
         if zipfile.is_zipfile(path):
             with _open(path) as data:

@@ -12,6 +12,7 @@ from pathlib import Path
 import neat
 
 from evorbc_ros.config import ConfigError, config_dir
+from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular_text
 from evorbc_ros.network import ACTIVATIONS, AGGREGATIONS
 from offline_evolution.arbitrator.neat_classes import EvoRBCGenome, TargetSpeciesSet
 
@@ -40,12 +41,10 @@ def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int)
     """
     source = str(path)
     parser = configparser.ConfigParser()
+    text = read_regular_text(path, "NEAT settings", ConfigError, SETTINGS_LIMIT)
     try:
-        with open(path, encoding="utf-8") as f:
-            parser.read_file(f)
-    except FileNotFoundError:
-        raise ConfigError(f"{source}: no such NEAT settings file") from None
-    except (OSError, UnicodeDecodeError, configparser.Error) as e:
+        parser.read_string(text, source)
+    except configparser.Error as e:
         first = str(e).strip().splitlines()[0]
         raise ConfigError(f"{source}: not a valid NEAT settings file ({first})") from None
     if not parser.has_section(GENOME_SECTION):

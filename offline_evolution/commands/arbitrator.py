@@ -8,7 +8,8 @@ import sys
 from collections import deque
 from pathlib import Path
 
-from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.cli_support import check_output_file
+from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire
 from offline_evolution.checkpoint import CheckpointError, Interrupted
 from offline_evolution.commands.common import (
     EXIT_INTERRUPTED,
@@ -16,9 +17,9 @@ from offline_evolution.commands.common import (
     StopOnSignal,
     add_workers_option,
     check_distinct,
-    check_writable,
     count,
     default_checkpoint,
+    exclusive_outputs,
     restart_from_scratch,
     write_then_discard,
 )
@@ -127,78 +128,25 @@ class _GenerationPrinter:
         )
 
 
-def cmd_evolve(args: argparse.Namespace) -> int:
-    """Evolve an arbitrator or a standard-NEAT controller and write its file and curve."""
-    from offline_evolution.arbitrator.evolve import (
-        CHECKPOINT_KIND,
-        EQUAL_BUDGET_GENERATIONS,
-        EvolutionSettings,
-        arbitrator_file,
-        evolve,
-        file_sha256,
-    )
-    from offline_evolution.arbitrator.settings import load_run_settings
-    from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+def _run(args, settings, every: int, repertoire, checkpoint: Path):
+    """Evolve (resuming from ``checkpoint``); the :class:`EvolutionResult`."""
+    from offline_evolution.arbitrator.evolve import CHECKPOINT_KIND, evolve
 
-    repertoire = None
-    if args.kind == "evorbc":
-        repertoire = Repertoire.load(args.repertoire)
-        robot = repertoire.robot
-    else:
-        robot = args.robot
-    run = load_run_settings(args.config, robot)
-    generations = args.generations if args.generations is not None else run.generations
-    if generations < 1:
-        raise CliError("--generations must be at least 1")
-    if args.kind == "standard" and args.equal_budget:
-        generations += EQUAL_BUDGET_GENERATIONS["hexapod" if robot == "hexapod" else "4ws"]
-    neat_file = Path(args.neat_config) if args.neat_config else run.neat_path()
-    task_settings = MazeTaskSettings.load(args.task or run.task_path())
-    if not neat_file.exists():
-        raise CliError(f"{neat_file}: no such NEAT settings file")
-    settings = EvolutionSettings(
-        kind=args.kind,
-        robot=robot,
-        generations=generations,
-        seed=args.seed,
-        neat_file=str(neat_file),
-        neat_sha256=file_sha256(neat_file),
-        task=task_settings.as_dict(),
-        mapping=(args.mapping or run.mapping) if args.kind == "evorbc" else None,
-        repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
-        **run.selection(),
-    )
-    out = Path(args.out)
-    plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")
-    checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.json")
-    check_distinct(
-        {
-            "--out": out,
-            "--plot": plot,
-            "--checkpoint": checkpoint,
-            "--repertoire": args.repertoire if repertoire else None,
-            "--config": args.config,
-            "--neat-config": args.neat_config,
-            "--task": args.task,
-        }
-    )
     if args.restart:
         restart_from_scratch(checkpoint, CHECKPOINT_KIND, "NEAT evolution checkpoint")
-    check_writable(out, plot)
-    every = args.checkpoint_every or run.checkpoint_every
     stop = StopOnSignal("generation")
     previous = stop.install()
     try:
-        result = evolve(
+        return evolve(
             settings,
             repertoire,
             checkpoint=checkpoint,
             checkpoint_every=every,
-            progress=_GenerationPrinter(args.quiet, generations),
+            progress=_GenerationPrinter(args.quiet, settings.generations),
             should_stop=stop,
             workers=args.workers or None,
             repertoire_source=args.repertoire if repertoire else "the repertoire",
-            keep_checkpoint=True,  # deleted only once the files below are written
+            keep_checkpoint=True,  # deleted only once the files are written
         )
     except CheckpointError as e:
         if e.discardable:
@@ -213,23 +161,98 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     finally:
         stop.restore(previous)
 
-    def write() -> None:
-        task = make_task(task_settings, robot, workers=1)
-        try:
-            arb = arbitrator_file(result, task, repertoire, args.repertoire if repertoire else None)
-            arb.save(out)
-        finally:
-            task.close()
-        from offline_evolution.plots.fitness import plot_fitness_history
 
-        plot_fitness_history(
-            result.history,
-            plot,
-            title=f"{'EvoRBC' if args.kind == 'evorbc' else 'standard NEAT'}, "
-            f"{robot}, seed {args.seed}",
-        )
+def cmd_evolve(args: argparse.Namespace) -> int:
+    """Evolve an arbitrator or a standard-NEAT controller and write its file and curve."""
+    from evorbc_ros.config import config_dir
+    from evorbc_ros.sensors import SensorLayout
+    from offline_evolution.arbitrator.evolve import (
+        EQUAL_BUDGET_GENERATIONS,
+        EvolutionSettings,
+        arbitrator_file,
+        file_sha256,
+    )
+    from offline_evolution.arbitrator.neat_config import load_neat_config
+    from offline_evolution.arbitrator.settings import load_run_settings
+    from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+    from offline_evolution.memory import check_evolution_memory
 
-    write_then_discard(checkpoint, write)
+    out = Path(args.out)
+    plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")
+    checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.json")
+    # Every output is checked before any work, so that a typo costs nothing.
+    check_output_file(str(out), "--out")
+    check_output_file(str(plot), "--plot" if args.plot else "the default --plot", picture=True)
+    repertoire = None
+    if args.kind == "evorbc":
+        repertoire = Repertoire.load(args.repertoire)
+        robot = repertoire.robot
+    else:
+        robot = args.robot
+    run = load_run_settings(args.config, robot)
+    generations = args.generations if args.generations is not None else run.generations
+    if args.kind == "standard" and args.equal_budget:
+        generations += EQUAL_BUDGET_GENERATIONS["hexapod" if robot == "hexapod" else "4ws"]
+    neat_file = Path(args.neat_config) if args.neat_config else run.neat_path()
+    task_settings = MazeTaskSettings.load(args.task or run.task_path())
+    settings = EvolutionSettings(
+        kind=args.kind,
+        robot=robot,
+        generations=generations,
+        seed=args.seed,
+        neat_file=str(neat_file),
+        neat_sha256=file_sha256(neat_file),
+        task=task_settings.as_dict(),
+        mapping=(args.mapping or run.mapping) if args.kind == "evorbc" else None,
+        repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
+        **run.selection(),
+    )
+    check_distinct(
+        {
+            "--out": out,
+            "--plot": plot,
+            "--checkpoint": checkpoint,
+            "--repertoire": args.repertoire if repertoire else None,
+            "--config": args.config,
+            "--neat-config": args.neat_config,
+            "--task": args.task,
+        }
+    )
+    # The NEAT settings and the task's memory, before any work.
+    layout = SensorLayout.load(config_dir() / task_settings.sensors)
+    n_outputs = 2 if args.kind == "evorbc" else ROBOT_PARAMETERS[robot]
+    pop_size = load_neat_config(neat_file, layout.n_inputs, n_outputs).pop_size
+    check_evolution_memory(
+        task_settings,
+        pop_size,
+        robot,
+        str(args.task or run.task_path()),
+        3 * run.hall_of_fame,
+        run.post_samples,
+    )
+    every = args.checkpoint_every or run.checkpoint_every
+    with exclusive_outputs({"--out": out, "--checkpoint": args.checkpoint}):
+        result = _run(args, settings, every, repertoire, checkpoint)
+
+        def write() -> None:
+            task = make_task(task_settings, robot, workers=1)
+            try:
+                arb = arbitrator_file(
+                    result, task, repertoire, args.repertoire if repertoire else None
+                )
+                arb.save(out)
+            finally:
+                task.close()
+            from offline_evolution.plots.fitness import plot_fitness_history
+
+            plot_fitness_history(
+                result.history,
+                plot,
+                title=f"{'EvoRBC' if args.kind == 'evorbc' else 'standard NEAT'}, "
+                f"{robot}, seed {args.seed}",
+            )
+
+        write_then_discard(checkpoint, write)
     label = "arbitrator" if args.kind == "evorbc" else "standard-NEAT controller"
     post = result.post_evaluation
     print(

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import fcntl
 import math
 import os
 import signal
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 EXIT_ERROR = 1
@@ -164,3 +166,82 @@ def restart_from_scratch(checkpoint: Path, kind: str, what: str) -> None:
             f"{e}, so --restart does not delete it; remove it yourself or choose "
             "another --checkpoint"
         ) from None
+
+
+def lock_file(path: str | os.PathLike) -> Path:
+    """The lock file of an output: ``.<name>.lock`` next to it."""
+    path = Path(path)
+    return path.with_name(f".{path.name}.lock")
+
+
+@contextlib.contextmanager
+def exclusive_outputs(files: dict[str, str | os.PathLike | None]) -> Iterator[None]:
+    """Hold an OS lock on each of ``files`` (option -> path; None skipped) for a run.
+
+    Two runs given the same ``--out`` would share one checkpoint, and the last to write
+    would win; the second is refused while the first runs. The lock (``flock`` on
+    :func:`lock_file`) belongs to the process, so the system releases it when the process
+    ends in any way, SIGKILL included: a killed run never blocks the next one. The lock
+    file is removed when the run ends normally.
+
+    Raises:
+        CliError: naming the option, the file and the running process.
+    """
+    with contextlib.ExitStack() as stack:
+        for option, path in files.items():
+            if path is not None:
+                stack.enter_context(_locked(Path(path), option))
+        yield
+
+
+@contextlib.contextmanager
+def _locked(path: Path, option: str) -> Iterator[None]:
+    lock = lock_file(path)
+    try:
+        lock.parent.mkdir(parents=True, exist_ok=True)
+        fd = _acquire(lock, path, option)
+    except OSError as e:
+        raise CliError(f"{option} {path}: cannot lock {lock} ({e.strerror})") from None
+    try:
+        yield
+    finally:
+        # Removed while still held: a run that opened it meanwhile sees it gone and
+        # retries with a new file rather than taking a lock nobody else will check.
+        with contextlib.suppress(OSError):
+            lock.unlink()
+        os.close(fd)
+
+
+def _acquire(lock: Path, path: Path, option: str, tries: int = 20) -> int:
+    """An open, locked descriptor of ``lock`` that is still the file at that path."""
+    for _ in range(tries):
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.read(fd, 32).decode(errors="replace").strip()
+            held = _same_file(lock, fd)
+            os.close(fd)
+            if held:
+                who = f" (pid {holder})" if holder.isdigit() else ""
+                raise CliError(
+                    f"{option} {path}: another run{who} is writing it; wait for it to "
+                    f"finish or choose another {option}"
+                ) from None
+            continue  # its holder was just removing it: try again with the new file
+        if _same_file(lock, fd):
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()}\n".encode())
+            return fd
+        os.close(fd)  # removed by a run that ended between our open and our lock
+    raise CliError(f"{option} {path}: cannot lock {lock}: it keeps changing")
+
+
+def _same_file(lock: Path, fd: int) -> bool:
+    """Whether the path ``lock`` still names the file open as ``fd``."""
+    try:
+        st = os.stat(lock)
+    except FileNotFoundError:
+        return False
+    fst = os.fstat(fd)
+    return (st.st_dev, st.st_ino) == (fst.st_dev, fst.st_ino)

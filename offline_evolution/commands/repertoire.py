@@ -7,7 +7,8 @@ import sys
 import time
 from pathlib import Path
 
-from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.cli_support import check_output_file
+from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire
 from offline_evolution.checkpoint import CheckpointError, Interrupted
 from offline_evolution.commands.common import (
     EXIT_INTERRUPTED,
@@ -15,9 +16,9 @@ from offline_evolution.commands.common import (
     StopOnSignal,
     add_workers_option,
     check_distinct,
-    check_writable,
     count,
     default_checkpoint,
+    exclusive_outputs,
     positive_float,
     restart_from_scratch,
     write_then_discard,
@@ -145,13 +146,8 @@ OPTIONS = {
 
 def cmd_repertoire(args: argparse.Namespace) -> int:
     """Generate a repertoire, write it (and optionally a plot and CSV), print a summary."""
-    from offline_evolution.repertoire.map_elites import CHECKPOINT_KIND, generate_repertoire
-    from offline_evolution.repertoire.settings import (
-        SettingError,
-        blame,
-        load_settings,
-        settings_path,
-    )
+    from offline_evolution.memory import check_repertoire_memory
+    from offline_evolution.repertoire.settings import load_settings, settings_path
 
     out = Path(args.out)
     checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.npz")
@@ -164,10 +160,38 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
             "--config": args.config,
         }
     )
+    # Every output is checked before any work, so that a typo costs nothing.
+    check_output_file(str(out), "--out")
+    if args.plot:
+        check_output_file(args.plot, "--plot", picture=True)
+    if args.csv:
+        check_output_file(args.csv, "--csv")
     given = {key: option for key, option in OPTIONS.items() if getattr(args, key) is not None}
     config = settings_path(args.config, args.robot)
     settings = load_settings(config, options=given, **{k: getattr(args, k) for k in OPTIONS})
-    check_writable(out, args.plot, args.csv)
+    check_repertoire_memory(
+        settings,
+        ROBOT_PARAMETERS[settings.robot],
+        lambda key: given.get(key) or f"{config}: {key}",
+    )
+    with exclusive_outputs({"--out": out, "--checkpoint": args.checkpoint}):
+        repertoire, elapsed = _run(args, settings, config, given, checkpoint)
+        write_then_discard(checkpoint, lambda: _write(repertoire, out, args.plot, args.csv))
+    s = repertoire.summary()
+    print(
+        f"{repertoire.robot} repertoire: {s['count']} primitives, mean quality "
+        f"{s['mean_quality']:.3f}, QD-score {s['qd_score']:.1f}, "
+        f"{repertoire.algorithm['evaluations']:,} evaluations in {elapsed:.1f} s "
+        f"(seed {settings.seed}) -> {out}"
+    )
+    return 0
+
+
+def _run(args, settings, config, given: dict, checkpoint: Path) -> tuple[Repertoire, float]:
+    """Run MAP-Elites (resuming from ``checkpoint``); the repertoire and the seconds taken."""
+    from offline_evolution.repertoire.map_elites import CHECKPOINT_KIND, generate_repertoire
+    from offline_evolution.repertoire.settings import SettingError, blame
+
     if args.restart:
         restart_from_scratch(checkpoint, CHECKPOINT_KIND, "MAP-Elites checkpoint")
     stop = StopOnSignal("batch")
@@ -198,6 +222,7 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
     finally:
         stop.restore(previous_handlers)
     elapsed = time.perf_counter() - start
+    out = args.out
     if len(repertoire) == 0:
         # A repertoire without primitives could drive nothing (and would not load).
         checkpoint.unlink(missing_ok=True)
@@ -206,15 +231,7 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
             "(each one left the archive's range or was discarded); nothing written to "
             f"{out}; try a larger budget or another --metric"
         )
-    write_then_discard(checkpoint, lambda: _write(repertoire, out, args.plot, args.csv))
-    s = repertoire.summary()
-    print(
-        f"{repertoire.robot} repertoire: {s['count']} primitives, mean quality "
-        f"{s['mean_quality']:.3f}, QD-score {s['qd_score']:.1f}, "
-        f"{repertoire.algorithm['evaluations']:,} evaluations in {elapsed:.1f} s "
-        f"(seed {settings.seed}) -> {out}"
-    )
-    return 0
+    return repertoire, elapsed
 
 
 def _write(repertoire: Repertoire, out: Path, plot: str | None, csv: str | None) -> None:
@@ -234,7 +251,7 @@ def cmd_export_csv(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path(args.repertoire).with_suffix(".csv")
     out_option = "--out" if args.out else "the default --out"
     check_distinct({"REPERTOIRE": args.repertoire, out_option: out})
-    check_writable(out)
+    check_output_file(str(out), out_option)
     repertoire.to_csv(out)
     print(f"{len(repertoire)} primitives -> {out}")
     return 0
