@@ -24,6 +24,11 @@ import yaml
 
 from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular_text
 
+#: The largest integer a float can hold; a larger one cannot be any setting.
+_FLOAT_MAX_INT = int(sys.float_info.max)
+#: The largest integer setting (numpy's int64).
+INT_LIMIT = 2**63 - 1
+
 
 class ConfigError(ValueError):
     """A settings file or value is not valid; the message names the file and key."""
@@ -55,7 +60,30 @@ def load_yaml_mapping(path: str | os.PathLike) -> dict[str, Any]:
         raise ConfigError(
             f"{source}: expected a mapping of settings at the top level, got {type(data).__name__}"
         )
+    where = _beyond_float(data)
+    if where:
+        raise ConfigError(
+            f"{source}: {where} is beyond float range (at most about 1.8e308): no setting "
+            "can hold it"
+        )
     return data
+
+
+def _beyond_float(data: Any, where: str = "") -> str | None:
+    """The key path of the first integer too large for a float, or None.
+
+    YAML reads 10**400 exactly; a float that large reads as infinity, which the settings
+    refuse as not finite.
+    """
+    if isinstance(data, int) and not isinstance(data, bool):
+        return where if abs(data) > _FLOAT_MAX_INT else None
+    if isinstance(data, dict):
+        items = ((f"{where}.{k}" if where else str(k), v) for k, v in data.items())
+    elif isinstance(data, list):
+        items = ((f"{where}[{i}]", v) for i, v in enumerate(data))
+    else:
+        return None
+    return next((w for key, value in items if (w := _beyond_float(value, key))), None)
 
 
 def _field_types(cls) -> dict[str, Any]:
@@ -79,6 +107,8 @@ def _check_value(name: str, value: Any, expected: Any, meta: dict, source: str) 
     elif expected is int:
         if isinstance(value, bool) or not isinstance(value, int):
             raise ConfigError(f"{source}: {name} must be an integer, got {value!r}")
+        if abs(value) > INT_LIMIT:  # numpy's int64 cannot hold it, nor any count we run
+            raise ConfigError(f"{source}: {name} must be at most {INT_LIMIT:,} in size")
     elif expected is bool:
         if not isinstance(value, bool):
             raise ConfigError(f"{source}: {name} must be true or false, got {value!r}")

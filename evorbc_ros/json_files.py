@@ -1,9 +1,19 @@
-"""Reading the JSON files users exchange, with one-line errors that name the file."""
+"""Reading the JSON files users exchange, with one-line errors that name the file.
+
+A number beyond float range (``10**400`` as a weight, ``1e400`` as an archive bound, a
+checkpoint's RNG state) is refused while parsing, with the key that holds it: Python reads
+such an integer exactly and such a float as infinity, so it would otherwise fail later,
+far from the file, as an internal error.
+"""
 
 from __future__ import annotations
 
 import json
+import math
 import os
+import re
+import reprlib
+import sys
 from typing import Any
 
 from evorbc_ros.input_files import DATA_LIMIT, read_regular_text
@@ -27,8 +37,55 @@ def load_json_file(
     """
     source = str(path)
     text = read_regular_text(path, what, error, limit)
+    return parse_json(text, source, what, error)
+
+
+#: The largest integer a float can hold (to within rounding): larger ones overflow.
+_FLOAT_MAX_INT = int(sys.float_info.max)
+#: An exponent of 100 or more: the only floats that may be beyond float range.
+_BIG_EXPONENT = re.compile(r"[eE]\+?0*[1-9]\d\d")
+
+
+class _BeyondFloat:
+    """A JSON number beyond float range, kept as its text until its key is found."""
+
+    __slots__ = ("text",)
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+
+def parse_json(text: str, source: str, what: str, error: type[Exception], range_error=None) -> Any:
+    """Parse JSON ``text`` read from ``source`` (see :func:`load_json_file` for errors).
+
+    Args:
+        range_error: what to raise for a number beyond float range (default ``error``).
+    """
+    seen = []
+
+    def parse_int(digits: str):
+        # No int() of a 5000-digit literal: Python refuses it with a ValueError of its own.
+        n = len(digits.lstrip("-"))
+        if n < 309 or (n == 309 and abs(int(digits)) <= _FLOAT_MAX_INT):
+            return int(digits)
+        seen.append(True)
+        return _BeyondFloat(digits)
+
+    def parse_float(digits: str):
+        value = float(digits)
+        if math.isinf(value):  # 1e400: a literal "Infinity" is parse_constant's
+            seen.append(True)
+            return _BeyondFloat(digits)
+        return value
+
+    # A hook costs a Python call per number. Integers are few in our files (counts,
+    # keys, seeds); floats are many, and only one with an exponent of 100 or more can
+    # overflow, which a quick search rules out.
+    hooks = {"parse_int": parse_int}
+    if _BIG_EXPONENT.search(text):
+        hooks["parse_float"] = parse_float
     try:
-        return json.loads(text)
+        data = json.loads(text, **hooks)
     except RecursionError:
         # The decoder recurses once per nesting level; no file of ours nests this deeply.
         raise error(f"{source}: corrupt {what} file (invalid JSON: nested too deeply)") from None
@@ -38,6 +95,30 @@ def load_json_file(
             f"{source}: {kind} {what} file (invalid JSON at line {e.lineno}, "
             f"column {e.colno}: {e.msg})"
         ) from None
+    if seen:
+        where, number = _beyond_float(data)
+        raise (range_error or error)(
+            f"{source}: {where or 'the top level'}: {reprlib.repr(number.text)} is beyond "
+            "float range (at most about 1.8e308)"
+        )
+    return data
+
+
+def _beyond_float(data: Any, where: str = "") -> tuple[str, _BeyondFloat] | None:
+    """The key path (``network.connections[3].weight``) of the first number out of range."""
+    if isinstance(data, _BeyondFloat):
+        return where, data
+    if isinstance(data, dict):
+        items = ((f"{where}.{k}" if where else str(k), v) for k, v in data.items())
+    elif isinstance(data, list):
+        items = ((f"{where}[{i}]", v) for i, v in enumerate(data))
+    else:
+        return None
+    for key, value in items:
+        found = _beyond_float(value, key)
+        if found:
+            return found
+    return None
 
 
 def first_difference(saved: dict, current: dict, where: str) -> str | None:

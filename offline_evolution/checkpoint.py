@@ -19,7 +19,7 @@ import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write
 from evorbc_ros.input_files import DATA_LIMIT, is_regular, read_regular
-from evorbc_ros.json_files import first_difference
+from evorbc_ros.json_files import first_difference, parse_json
 
 _HEADER = "__header__"
 
@@ -66,14 +66,29 @@ def _header(data, source: str) -> dict:
     if _HEADER not in data.files:
         raise CheckpointError(f"{source}: not a checkpoint (no header)", discardable=False)
     try:
-        header = json.loads(str(data[_HEADER]))
+        text = str(data[_HEADER])
     except _READ_ERRORS as e:
         raise CheckpointError(
             f"{source}: not a checkpoint ({_reason(e)})", discardable=False
         ) from None
+    try:
+        header = parse_json(text, f"{source}: header", "checkpoint", _NotJson, _bad)
+    except _NotJson:
+        raise CheckpointError(
+            f"{source}: not a checkpoint (its header is not JSON)", discardable=False
+        ) from None
     if not isinstance(header, dict):
         raise CheckpointError(f"{source}: not a checkpoint (bad header)", discardable=False)
     return header
+
+
+class _NotJson(ValueError):
+    """The text is not JSON (the caller says what that makes the file)."""
+
+
+def _bad(message: str) -> CheckpointError:
+    """A checkpoint that holds a value no run writes (a number beyond float range)."""
+    return CheckpointError(message)
 
 
 def _not_ours(message: str) -> CheckpointError:
@@ -129,10 +144,9 @@ def load_json_checkpoint(path: str | os.PathLike) -> dict:
         CheckpointError: unreadable, not JSON or not a JSON object (not ``discardable``).
 
     """
-    text = _read(path)
     try:
-        data = json.loads(text.decode("utf-8"))
-    except (UnicodeDecodeError, RecursionError, json.JSONDecodeError):
+        data = parse_json(_read(path).decode("utf-8"), str(path), "checkpoint", _NotJson, _bad)
+    except (UnicodeDecodeError, _NotJson):
         raise CheckpointError(f"{path}: not a checkpoint (not JSON)", discardable=False) from None
     if not isinstance(data, dict):
         raise CheckpointError(f"{path}: not a checkpoint (not a JSON object)", discardable=False)

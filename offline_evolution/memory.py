@@ -40,6 +40,8 @@ def machine_memory() -> int:
 
 
 def _gib(n: float) -> str:
+    if n >= 1e18 * GIB:  # settings far beyond any machine (a count of 10**30)
+        return "more than 10^18 GiB"
     return f"{n / GIB:.1f} GiB" if n >= GIB / 10 else f"{n / (1 << 20):.0f} MiB"
 
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.cli_support import check_output_file
-from evorbc_ros.config import build_settings, config_dir
+from evorbc_ros.config import config_dir
 from evorbc_ros.defaults import default_repertoire
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.commands.common import CliError, count
@@ -129,7 +129,9 @@ def check_design(
 def cmd_replay(args: argparse.Namespace) -> int:
     """Replay and report; optionally draw trajectories and the selection heatmap."""
     from offline_evolution.maze_task.replay import replay, summarise_outcomes
-    from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+    from offline_evolution.maze_task.task import CONTROL_PERIOD, MazeTaskSettings, make_task
+    from offline_evolution.memory import check_replay_memory
+    from sim_bridge.robots.base import control_steps
 
     arb_path = Path(args.arbitrator)
     if args.episodes < 1 or (args.episodes > 1 and args.start != "random"):
@@ -151,12 +153,21 @@ def cmd_replay(args: argparse.Namespace) -> int:
     if args.task:
         settings = MazeTaskSettings.load(args.task)
     elif recorded:
-        settings = build_settings(MazeTaskSettings, recorded, f"{arb_path}: evolution.task")
+        settings = MazeTaskSettings.from_dict(recorded, f"{arb_path}: evolution.task")
     else:
         family = "hexapod" if arb.robot == "hexapod" else "4ws"
         settings = MazeTaskSettings.load(config_dir() / "tasks" / f"maze-{family}.yaml")
     if args.maze != "all":
         settings = MazeTaskSettings((args.maze,), settings.episode_time, 1, settings.sensors)
+    where = args.task or (f"{arb_path}: evolution.task" if recorded else "the default task")
+    per_maze = args.episodes * settings.samples_per_maze if args.start == "random" else 1
+    check_replay_memory(
+        len(settings.mazes) * per_maze,
+        control_steps(settings.episode_time, CONTROL_PERIOD),
+        len(arb.network.output_keys),
+        arb.robot,
+        f"episode_time {settings.episode_time} s in {where}",
+    )
     task = make_task(settings, arb.robot)
     try:
         check_design(task.describe(), arb, arb_path, repertoire, rep_path)
