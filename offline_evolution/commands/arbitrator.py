@@ -16,6 +16,7 @@ from offline_evolution.commands.common import (
     CliError,
     StopOnSignal,
     add_workers_option,
+    at_least,
     check_distinct,
     count,
     default_checkpoint,
@@ -28,7 +29,7 @@ from offline_evolution.commands.common import (
 def _common_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--generations",
-        type=count,
+        type=at_least(1),
         metavar="N",
         help="NEAT generations (default: config/arbitrator/<family>.yaml, Table I)",
     )
@@ -96,20 +97,29 @@ def add_parsers(sub) -> None:
 
 
 class _GenerationPrinter:
-    """One line per generation on stderr."""
+    """One line per generation on stderr, with an ETA once it means something.
+
+    The first generation a process runs also compiles the simulation kernels (seconds
+    where a generation then takes a fraction of one), so it never enters the ETA. The ETA
+    uses the median of the last ten generations after it (one slow generation, the machine
+    busy or the run paused, does not make it jump tenfold) and is shown from the second of
+    them on.
+    """
+
+    #: Generations measured (after the first) before an ETA is shown.
+    MIN_MEASURED = 2
 
     def __init__(self, quiet: bool, total: int) -> None:
         self.quiet = quiet
         self.total = total
         self.announced = False
-        # The ETA uses the median of recent generations (s), so one slow generation (the
-        # machine busy, the run paused) does not make it jump tenfold.
-        self.recent: deque[float] = deque(maxlen=10)
+        self.recent: deque[float] = deque(maxlen=10)  # s per generation
 
     def __call__(self, stats, settings) -> None:
         if self.quiet:
             return
-        if not self.announced:
+        first = not self.announced
+        if first:
             self.announced = True
             if stats.generation > 0:  # the first generation run here was not the run's first
                 print(
@@ -117,15 +127,24 @@ class _GenerationPrinter:
                     f"{self.total} are done",
                     file=sys.stderr,
                 )
-        self.recent.append(stats.seconds)
-        remaining = (self.total - stats.generation - 1) * statistics.median(self.recent)
+        else:
+            self.recent.append(stats.seconds)
         print(
             f"generation {stats.generation + 1:>4}/{self.total}  best {stats.best:6.3f}  "
             f"mean {stats.mean:6.3f}  best so far {stats.best_so_far:6.3f}  "
             f"species {stats.species:>2}  reached {stats.best_reached}  "
-            f"{stats.seconds:5.2f} s/gen  eta {remaining / 60:5.1f} min",
+            f"{stats.seconds:5.2f} s/gen  {self.eta(stats.generation + 1)}",
             file=sys.stderr,
         )
+
+    def eta(self, done: int) -> str:
+        """``eta N.N min`` for the generations left, or ``eta --`` until it is meaningful."""
+        if done >= self.total:
+            return "done"
+        if len(self.recent) < self.MIN_MEASURED:
+            return "eta   --"
+        remaining = (self.total - done) * statistics.median(self.recent)
+        return f"eta {remaining / 60:5.1f} min"
 
 
 def _run(args, settings, every: int, repertoire, checkpoint: Path):

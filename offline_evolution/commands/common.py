@@ -25,6 +25,36 @@ class CliError(Exception):
         self.code = code
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (no usage block) and status 2.
+
+    Every bad option value ends the same way, whether the parser or a later check finds
+    it: ``evorbc-evolve arbitrator: error: argument --generations: expected an integer
+    >= 1, got '0'``; ``--help`` shows the usage.
+    """
+
+    def error(self, message: str):
+        """Print one line and exit with the usage status."""
+        text = " ".join(message.split())
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {text} (see {self.prog} --help)\n")
+
+
+def at_least(low: int):
+    """Argparse type: an integer >= ``low``."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {text!r}")
+        return value
+
+    parse.__name__ = f"integer >= {low}"
+    return parse
+
+
 def positive_float(text: str) -> float:
     """Argparse type: a finite number > 0."""
     try:

@@ -100,13 +100,22 @@ def add_parsers(sub) -> None:
 
 
 class _ProgressPrinter:
-    """Prints a progress line to stderr at most every ``interval`` seconds, and the last."""
+    """Prints a progress line to stderr at most every ``interval`` seconds, and the last.
+
+    The rate and ETA leave out the first batch a process runs, which also compiles the
+    simulation kernels (or starts the workers): they come from the batches after it, and
+    the ETA is shown once those have run for :attr:`MIN_SECONDS` (``eta --`` before).
+    """
+
+    #: Seconds of batches after the first before the ETA is shown.
+    MIN_SECONDS = 2.0
 
     def __init__(self, quiet: bool, interval: float = 1.0) -> None:
         self.quiet = quiet
         self.interval = interval
         self.last = -float("inf")
         self.announced = False
+        self.after_first: tuple[float, int] | None = None  # (s, evaluations) after batch 1
 
     def __call__(self, p) -> None:
         if self.quiet:
@@ -114,19 +123,35 @@ class _ProgressPrinter:
         if p.resumed_from is not None and not self.announced:
             print(f"resuming from the checkpoint at iteration {p.resumed_from}", file=sys.stderr)
         self.announced = True
+        if self.after_first is None:
+            self.after_first = (p.elapsed, p.evaluations)
         now = time.perf_counter()
         if now - self.last < self.interval and p.iteration < p.iterations:
             return
         self.last = now
-        rate = p.rate
+        rate, eta = self.rate_and_eta(p)
         speed = f"{rate / 1e3:7.0f}k eval/s" if rate >= 1e4 else f"{rate:7.1f} eval/s"
-        eta = f"  eta {p.eta / 60:6.1f} min" if rate < 1e4 and p.eta != float("inf") else ""
         print(
             f"iteration {p.iteration:>5}/{p.iterations}  evaluations {p.evaluations:>9,}  "
             f"primitives {p.cells:>5}  mean quality {p.mean_quality:.3f}  "
             f"QD-score {p.qd_score:8.1f}  {speed}{eta}",
             file=sys.stderr,
         )
+
+    def rate_and_eta(self, p) -> tuple[float, str]:
+        """Evaluations/s and the ETA text (empty for fast runs, done in moments).
+
+        The rate is measured after the first batch (this process's overall rate until
+        then); the ETA waits for :attr:`MIN_SECONDS` of such batches.
+        """
+        t0, e0 = self.after_first
+        seconds, done = p.elapsed - t0, p.evaluations - e0
+        rate = done / seconds if seconds > 0 and done > 0 else p.rate
+        if rate >= 1e4 or p.evaluations >= p.total_evaluations:
+            return rate, ""
+        if seconds < self.MIN_SECONDS or done <= 0:
+            return rate, "  eta   --"
+        return rate, f"  eta {(p.total_evaluations - p.evaluations) / rate / 60:6.1f} min"
 
 
 #: Setting key -> the option that overrides it.

@@ -14,7 +14,7 @@ from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.config import config_dir
 from evorbc_ros.defaults import default_repertoire
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.commands.common import CliError, count
+from offline_evolution.commands.common import CliError, at_least, count
 from sim_bridge.robots.hexapod import check_simulation, simulation_mismatch
 
 #: How a user lets another repertoire fingerprint or sensor layout through.
@@ -56,7 +56,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--seed", type=count, default=0, metavar="N", help="seed of random starts")
     p.add_argument(
         "--episodes",
-        type=count,
+        type=at_least(1),
         default=1,
         metavar="N",
         help="with --start random: N random starts per maze, reported per maze as how "
@@ -134,7 +134,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
     from sim_bridge.robots.base import control_steps
 
     arb_path = Path(args.arbitrator)
-    if args.episodes < 1 or (args.episodes > 1 and args.start != "random"):
+    if args.episodes > 1 and args.start != "random":
         raise CliError("--episodes N needs N >= 1, and N > 1 needs --start random")
     for path, option in ((args.plot, "--plot"), (args.heatmap, "--heatmap")):
         if path:
