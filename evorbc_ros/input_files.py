@@ -42,16 +42,21 @@ def file_problem(path: str | os.PathLike, what: str, limit: int) -> str | None:
 
 def _mode_problem(st: os.stat_result, what: str, limit: int) -> str | None:
     if stat.S_ISDIR(st.st_mode):
-        return f"is a folder, expected a {what} file"
+        return f"is a folder, expected {_a(what)} file"
     if not stat.S_ISREG(st.st_mode):
         kind = next((name for test, name in _KINDS if test(st.st_mode)), "not a file")
-        return f"is {kind}, not a regular file; expected a {what} file"
+        return f"is {kind}, not a regular file; expected {_a(what)} file"
     if st.st_size > limit:
         return (
-            f"is {_size(st.st_size)}, too large for a {what} file (at most {_size(limit)}); "
+            f"is {_size(st.st_size)}, too large for {_a(what)} file (at most {_size(limit)}); "
             "is it the right file?"
         )
     return None
+
+
+def _a(what: str) -> str:
+    """``what`` with its article: "a repertoire", "an arbitrator"."""
+    return f"{'an' if what[:1].lower() in 'aeiou' else 'a'} {what}"
 
 
 def _size(n: int) -> str:
@@ -90,7 +95,7 @@ def read_regular(path: str | os.PathLike, what: str, error: type[Exception], lim
         except OSError as e:
             raise error(f"{source}: cannot read ({e.strerror})") from None
     if len(data) > limit:  # it grew while being read
-        raise error(f"{source}: too large for a {what} file (at most {_size(limit)})")
+        raise error(f"{source}: too large for {_a(what)} file (at most {_size(limit)})")
     return data
 
 
