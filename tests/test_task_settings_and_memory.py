@@ -97,5 +97,5 @@ def test_a_repertoire_archive_that_cannot_fit_is_refused(tmp_path, capsys):
 def test_the_limit_follows_the_machine(monkeypatch):
     monkeypatch.setattr(memory, "machine_memory", lambda: 64 * GIB)
     memory.check_memory(20 * GIB, "x", "y")  # fits in half of 64 GiB
-    with pytest.raises(ConfigError, match="needs about 40.0 GiB of memory, more than"):
+    with pytest.raises(ConfigError, match=r"needs about 40\.0 GiB of memory, more than"):
         memory.check_memory(40 * GIB, "x", "y")
