@@ -10,6 +10,7 @@ import os
 import resource
 import subprocess
 import sys
+import threading
 
 import pytest
 
@@ -21,6 +22,8 @@ from offline_evolution.arbitrator.neat_config import load_neat_config
 from offline_evolution.checkpoint import CheckpointError, checkpoint_kind, load_checkpoint
 
 GIB = 1 << 30
+#: How often a reader opened each test FIFO: never, when only regular files are read.
+READER_OPENS = {}
 
 
 def _limits():
@@ -41,9 +44,25 @@ def evolve_cli(*argv, timeout=60):
 
 @pytest.fixture
 def fifo(tmp_path):
+    """A FIFO. A reader that opens it anyway (the bug) gets end-of-file from a helper
+    writer rather than blocking the test forever."""
     path = tmp_path / "r.json"
     os.mkfifo(path)
-    return path
+    READER_OPENS[path] = 0
+    stop = threading.Event()
+
+    def feeder():
+        while not stop.is_set():
+            os.close(os.open(path, os.O_WRONLY))  # blocks until some reader opens it
+            if not stop.is_set():
+                READER_OPENS[path] += 1
+
+    thread = threading.Thread(target=feeder, daemon=True)
+    thread.start()
+    yield path
+    stop.set()
+    os.close(os.open(path, os.O_RDONLY | os.O_NONBLOCK))  # lets the feeder's open return
+    thread.join(5)
 
 
 def test_export_csv_refuses_a_fifo_at_once(tmp_path, fifo):
@@ -78,12 +97,13 @@ def test_every_loader_refuses_fifos_folders_and_devices(tmp_path, fifo, load, er
     for path, kind in [
         (fifo, "is a FIFO, not a regular file"),
         (tmp_path, "is a folder"),
-        ("/dev/zero", "is a character device, not a regular file"),
+        ("/dev/null", "is a character device, not a regular file"),  # /dev/zero: a subprocess
     ]:
         with pytest.raises(error) as info:
             load(path)
         message = str(info.value)
         assert message.startswith(f"{path}: {kind}") and what in message
+    assert READER_OPENS[fifo] == 0
 
 
 def test_a_file_far_larger_than_its_format_is_refused_before_reading(tmp_path):
@@ -102,3 +122,4 @@ def test_restart_and_checkpoint_checks_never_open_a_fifo(tmp_path, fifo):
     )  # fmt: skip
     assert done.returncode == 1 and "--restart does not delete it" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and fifo.exists()
+    assert READER_OPENS[fifo] == 0
