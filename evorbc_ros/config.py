@@ -23,6 +23,7 @@ from typing import Any
 import yaml
 
 from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular_text
+from evorbc_ros.json_files import find_value
 
 #: The largest integer a float can hold; a larger one cannot be any setting.
 _FLOAT_MAX_INT = int(sys.float_info.max)
@@ -60,30 +61,17 @@ def load_yaml_mapping(path: str | os.PathLike) -> dict[str, Any]:
         raise ConfigError(
             f"{source}: expected a mapping of settings at the top level, got {type(data).__name__}"
         )
-    where = _beyond_float(data)
-    if where:
+    # YAML reads 10**400 exactly (a float that large reads as infinity, which settings
+    # refuse as not finite): no setting can hold it.
+    found = find_value(
+        data, lambda v: isinstance(v, int) and not isinstance(v, bool) and abs(v) > _FLOAT_MAX_INT
+    )
+    if found:
         raise ConfigError(
-            f"{source}: {where} is beyond float range (at most about 1.8e308): no setting "
+            f"{source}: {found[0]} is beyond float range (at most about 1.8e308): no setting "
             "can hold it"
         )
     return data
-
-
-def _beyond_float(data: Any, where: str = "") -> str | None:
-    """The key path of the first integer too large for a float, or None.
-
-    YAML reads 10**400 exactly; a float that large reads as infinity, which the settings
-    refuse as not finite.
-    """
-    if isinstance(data, int) and not isinstance(data, bool):
-        return where if abs(data) > _FLOAT_MAX_INT else None
-    if isinstance(data, dict):
-        items = ((f"{where}.{k}" if where else str(k), v) for k, v in data.items())
-    elif isinstance(data, list):
-        items = ((f"{where}[{i}]", v) for i, v in enumerate(data))
-    else:
-        return None
-    return next((w for key, value in items if (w := _beyond_float(value, key))), None)
 
 
 def _field_types(cls) -> dict[str, Any]:

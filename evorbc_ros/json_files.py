@@ -96,7 +96,7 @@ def parse_json(text: str, source: str, what: str, error: type[Exception], range_
             f"column {e.colno}: {e.msg})"
         ) from None
     if seen:
-        where, number = _beyond_float(data)
+        where, number = find_value(data, lambda v: isinstance(v, _BeyondFloat))
         raise (range_error or error)(
             f"{source}: {where or 'the top level'}: {reprlib.repr(number.text)} is beyond "
             "float range (at most about 1.8e308)"
@@ -104,9 +104,12 @@ def parse_json(text: str, source: str, what: str, error: type[Exception], range_
     return data
 
 
-def _beyond_float(data: Any, where: str = "") -> tuple[str, _BeyondFloat] | None:
-    """The key path (``network.connections[3].weight``) of the first number out of range."""
-    if isinstance(data, _BeyondFloat):
+def find_value(data: Any, wanted, where: str = "") -> tuple[str, Any] | None:
+    """``(key path, value)`` of the first value in nested ``data`` with ``wanted(value)``.
+
+    Paths read like the files' keys: ``network.connections[3].weight``; None if none.
+    """
+    if wanted(data):
         return where, data
     if isinstance(data, dict):
         items = ((f"{where}.{k}" if where else str(k), v) for k, v in data.items())
@@ -115,7 +118,7 @@ def _beyond_float(data: Any, where: str = "") -> tuple[str, _BeyondFloat] | None
     else:
         return None
     for key, value in items:
-        found = _beyond_float(value, key)
+        found = find_value(value, wanted, key)
         if found:
             return found
     return None

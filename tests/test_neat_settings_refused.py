@@ -2,20 +2,11 @@
 counts, a NaN threshold, unknown criteria and init types) are refused at load, in one line
 naming the file, section and key."""
 
-import re
-
 import pytest
+from test_neat_config_errors import with_setting
 
-from evorbc_ros.config import ConfigError, config_dir
+from evorbc_ros.config import ConfigError
 from offline_evolution.arbitrator.neat_config import load_neat_config
-
-SHIPPED = (config_dir() / "neat" / "4ws.ini").read_text()
-
-
-def with_setting(key, value):
-    text, n = re.subn(rf"^{key}\s*=.*$", f"{key} = {value}", SHIPPED, flags=re.M)
-    assert n == 1
-    return text
 
 
 @pytest.mark.parametrize(

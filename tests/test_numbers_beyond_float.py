@@ -10,6 +10,7 @@ import re
 
 import numpy as np
 import pytest
+from test_errors_checkpoints import neat_checkpoint, one_line_error  # noqa: F401
 
 from evorbc_ros.config import ConfigError, config_dir, load_yaml_mapping
 from evorbc_ros.defaults import default_arbitrator, default_repertoire
@@ -18,20 +19,11 @@ from evorbc_ros.sensors import SensorLayout
 from offline_evolution.arbitrator.evolve import evolve
 from offline_evolution.arbitrator.neat_config import load_neat_config
 from offline_evolution.checkpoint import CheckpointError, Interrupted, load_checkpoint
-from offline_evolution.cli import main
 from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
 from sim_bridge.maze import load_named_maze
 
 HUGE = "1" + "0" * 400  # 10**400, as it would stand in a file
-
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    err = capsys.readouterr().err.strip()
-    assert "internal error" not in err and "Traceback" not in err, err
-    assert code == 1 and len(err.splitlines()) == 1, err
-    return err
 
 
 def json_with(data, path, literal):
@@ -52,7 +44,7 @@ REP = json.loads(default_repertoire().read_text())
 def test_an_arbitrator_weight_beyond_float_range(tmp_path, capsys, literal):
     path = tmp_path / "a.json"
     path.write_text(json_with(ARB, ["network", "connections", 3, "weight"], literal))
-    err = run(capsys, "replay", "--arbitrator", path)
+    err = one_line_error(capsys, "replay", "--arbitrator", path)
     assert err.startswith(f"evorbc-evolve: error: {path}: network.connections[3].weight: ")
     assert "is beyond float range" in err
 
@@ -66,7 +58,7 @@ def test_a_repertoire_number_beyond_float_range(tmp_path, capsys, key):
     where = ".".join(str(k) for k in key).replace(".1", "[1]").replace(".7.0", "[7][0]")
     with pytest.raises(RepertoireError, match=re.escape(f"{path}: {where}: '1000")):
         Repertoire.load(path)
-    err = run(capsys, "export-csv", path, "--out", tmp_path / "r.csv")
+    err = one_line_error(capsys, "export-csv", path, "--out", tmp_path / "r.csv")
     assert "is beyond float range" in err
 
 
@@ -87,7 +79,7 @@ def test_settings_files_with_an_integer_beyond_float_range(tmp_path, capsys):
         SensorLayout.load(layout)
     config = tmp_path / "rep.yaml"
     config.write_text(f"robot: 4ws-5\nseed: {HUGE}\n")
-    err = run(capsys, "repertoire", "--config", config, "--out", tmp_path / "r.json")
+    err = one_line_error(capsys, "repertoire", "--config", config, "--out", tmp_path / "r.json")
     assert err == f"evorbc-evolve: error: {config}: seed is beyond float range (at most " + (
         "about 1.8e308): no setting can hold it"
     )
@@ -97,7 +89,7 @@ def test_an_integer_setting_beyond_int64_is_refused(tmp_path, capsys):
     config = tmp_path / "rep.yaml"
     shipped = (config_dir() / "repertoire" / "4ws.yaml").read_text()
     config.write_text(shipped + "seed: 100000000000000000000000\n")
-    err = run(capsys, "repertoire", "--config", config, "--out", tmp_path / "r.json")
+    err = one_line_error(capsys, "repertoire", "--config", config, "--out", tmp_path / "r.json")
     assert "seed must be at most 9,223,372,036,854,775,807 in size" in err
 
 
@@ -115,17 +107,6 @@ def test_a_neat_file_with_a_number_beyond_float_range(tmp_path):
 # -- checkpoints ------------------------------------------------------------------------------
 
 
-@pytest.fixture
-def neat_checkpoint(tmp_path, small_neat_file, small_repertoire):
-    from test_evolution import settings
-
-    s = settings(small_neat_file, generations=3, repertoire=small_repertoire)
-    ckpt = tmp_path / "a.checkpoint.json"
-    with pytest.raises(Interrupted):
-        evolve(s, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
-    return s, ckpt
-
-
 @pytest.mark.parametrize(
     ("literal", "reason"),
     [
@@ -133,9 +114,8 @@ def neat_checkpoint(tmp_path, small_neat_file, small_repertoire):
         ("100000000000000000000000000000000000000000000000000", "population.random_state is not"),
     ],
 )
-def test_a_neat_checkpoint_rng_state_out_of_range(neat_checkpoint, small_repertoire, literal,
-                                                  reason):  # fmt: skip
-    s, ckpt = neat_checkpoint
+def test_a_neat_checkpoint_rng_state_out_of_range(request, small_repertoire, literal, reason):
+    s, ckpt = request.getfixturevalue("neat_checkpoint")  # test_errors_checkpoints' fixture
     data = json.loads(ckpt.read_text())
     ckpt.write_text(json_with(data, ["population", "random_state", 1, 5], literal))
     with pytest.raises(CheckpointError) as info:

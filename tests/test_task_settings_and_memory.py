@@ -8,6 +8,7 @@ import sys
 
 import pytest
 import yaml
+from test_errors_checkpoints import one_line_error
 
 from evorbc_ros.config import ConfigError
 from evorbc_ros.defaults import default_arbitrator
@@ -52,14 +53,6 @@ def run_limited(*argv):
     return err
 
 
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    err = capsys.readouterr().err.strip()
-    assert "internal error" not in err and "Traceback" not in err, err
-    assert code == 1 and len(err.splitlines()) == 1, err
-    return err
-
-
 def arbitrator_with_task(tmp_path, **task):
     data = json.loads(json.dumps(ARB))
     data["evolution"]["task"].update(task)
@@ -79,7 +72,7 @@ def arbitrator_with_task(tmp_path, **task):
 )
 def test_the_task_inside_an_arbitrator_file_is_checked_like_task(tmp_path, capsys, task, needle):
     path = arbitrator_with_task(tmp_path, **task)
-    err = run(capsys, "replay", "--arbitrator", path)
+    err = one_line_error(capsys, "replay", "--arbitrator", path)
     assert err.startswith("evorbc-evolve: error: ") and needle in err
 
 

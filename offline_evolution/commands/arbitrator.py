@@ -10,11 +10,7 @@ from pathlib import Path
 
 from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire
-from offline_evolution.checkpoint import CheckpointError, Interrupted
 from offline_evolution.commands.common import (
-    EXIT_INTERRUPTED,
-    CliError,
-    StopOnSignal,
     add_workers_option,
     at_least,
     check_distinct,
@@ -22,6 +18,7 @@ from offline_evolution.commands.common import (
     default_checkpoint,
     exclusive_outputs,
     restart_from_scratch,
+    running,
     write_then_discard,
 )
 
@@ -153,9 +150,7 @@ def _run(args, settings, every: int, repertoire, checkpoint: Path):
 
     if args.restart:
         restart_from_scratch(checkpoint, CHECKPOINT_KIND, "NEAT evolution checkpoint")
-    stop = StopOnSignal("generation")
-    previous = stop.install()
-    try:
+    with running("generation", "generation") as stop:
         return evolve(
             settings,
             repertoire,
@@ -167,18 +162,6 @@ def _run(args, settings, every: int, repertoire, checkpoint: Path):
             repertoire_source=args.repertoire if repertoire else "the repertoire",
             keep_checkpoint=True,  # deleted only once the files are written
         )
-    except CheckpointError as e:
-        if e.discardable:
-            raise CliError(f"{e}; use --restart to discard it") from None
-        raise CliError(f"{e}; choose another --checkpoint") from None
-    except Interrupted as e:
-        raise CliError(
-            f"interrupted after generation {e.iteration}; finished work is saved "
-            f"in {e.checkpoint}; run the same command again to resume",
-            EXIT_INTERRUPTED,
-        ) from None
-    finally:
-        stop.restore(previous)
 
 
 def cmd_evolve(args: argparse.Namespace) -> int:

@@ -109,6 +109,34 @@ class StopOnSignal:
             signal.signal(sig, old)
 
 
+@contextlib.contextmanager
+def running(step: str, unit: str) -> Iterator[StopOnSignal]:
+    """A long run's frame: Ctrl-C finishes the current ``step``; errors become one line.
+
+    Yields the :class:`StopOnSignal` to poll. A checkpoint that cannot be used, and the
+    interruption (status 130), end as :class:`CliError` saying what to do next; ``unit``
+    names what the run counts ("iteration", "generation").
+    """
+    from offline_evolution.checkpoint import CheckpointError, Interrupted
+
+    stop = StopOnSignal(step)
+    previous = stop.install()
+    try:
+        yield stop
+    except CheckpointError as e:
+        if e.discardable:
+            raise CliError(f"{e}; use --restart to discard it") from None
+        raise CliError(f"{e}; choose another --checkpoint") from None
+    except Interrupted as e:
+        raise CliError(
+            f"interrupted after {unit} {e.iteration}; finished work is saved in "
+            f"{e.checkpoint}; run the same command again to resume",
+            EXIT_INTERRUPTED,
+        ) from None
+    finally:
+        stop.restore(previous)
+
+
 def add_workers_option(parser: argparse.ArgumentParser) -> None:
     """``--workers N``: processes for PyBullet simulations (results do not depend on it)."""
     parser.add_argument(
@@ -118,22 +146,6 @@ def add_workers_option(parser: argparse.ArgumentParser) -> None:
         help="worker processes for robots simulated in PyBullet (default: one per core); "
         "results are the same for any number",
     )
-
-
-def check_writable(*paths) -> None:
-    """Fail early (before a long run) if an output folder cannot be created or written."""
-    for p in paths:
-        if p is None:
-            continue
-        folder = Path(p).resolve().parent
-        try:
-            folder.mkdir(parents=True, exist_ok=True)
-        except OSError as e:
-            raise CliError(f"{p}: cannot create folder {folder} ({e.strerror})") from None
-        if not os.access(folder, os.W_OK):
-            raise CliError(f"{p}: folder {folder} is not writable")
-        if Path(p).is_dir():
-            raise CliError(f"{p}: is a folder, expected a file name")
 
 
 def default_checkpoint(out: Path, given: str | None, suffix: str) -> Path:

@@ -9,11 +9,8 @@ from pathlib import Path
 
 from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire
-from offline_evolution.checkpoint import CheckpointError, Interrupted
 from offline_evolution.commands.common import (
-    EXIT_INTERRUPTED,
     CliError,
-    StopOnSignal,
     add_workers_option,
     check_distinct,
     count,
@@ -21,6 +18,7 @@ from offline_evolution.commands.common import (
     exclusive_outputs,
     positive_float,
     restart_from_scratch,
+    running,
     write_then_discard,
 )
 
@@ -219,33 +217,20 @@ def _run(args, settings, config, given: dict, checkpoint: Path) -> tuple[Reperto
 
     if args.restart:
         restart_from_scratch(checkpoint, CHECKPOINT_KIND, "MAP-Elites checkpoint")
-    stop = StopOnSignal("batch")
-    previous_handlers = stop.install()
     start = time.perf_counter()
-    try:
-        repertoire = generate_repertoire(
-            settings,
-            checkpoint=checkpoint,
-            checkpoint_every=args.checkpoint_every,
-            progress=_ProgressPrinter(args.quiet),
-            should_stop=stop,
-            workers=args.workers or None,
-            keep_checkpoint=True,
-        )
-    except SettingError as e:
-        raise blame(e, config, given) from None
-    except CheckpointError as e:
-        if e.discardable:
-            raise CliError(f"{e}; use --restart to discard it") from None
-        raise CliError(f"{e}; choose another --checkpoint") from None
-    except Interrupted as e:
-        raise CliError(
-            f"interrupted after iteration {e.iteration}; finished work is saved in "
-            f"{e.checkpoint}; run the same command again to resume",
-            EXIT_INTERRUPTED,
-        ) from None
-    finally:
-        stop.restore(previous_handlers)
+    with running("batch", "iteration") as stop:
+        try:
+            repertoire = generate_repertoire(
+                settings,
+                checkpoint=checkpoint,
+                checkpoint_every=args.checkpoint_every,
+                progress=_ProgressPrinter(args.quiet),
+                should_stop=stop,
+                workers=args.workers or None,
+                keep_checkpoint=True,
+            )
+        except SettingError as e:
+            raise blame(e, config, given) from None
     elapsed = time.perf_counter() - start
     out = args.out
     if len(repertoire) == 0:
