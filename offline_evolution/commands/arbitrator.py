@@ -97,14 +97,14 @@ class _GenerationPrinter:
     """One line per generation on stderr, with an ETA once it means something.
 
     The first generation a process runs also compiles the simulation kernels (seconds
-    where a generation then takes a fraction of one), so it never enters the ETA. The ETA
-    uses the median of the last ten generations after it (one slow generation, the machine
-    busy or the run paused, does not make it jump tenfold) and is shown from the second of
-    them on.
+    where a generation then takes a fraction of one). The ETA is the median of the last
+    ten generations times those left, shown from the third generation measured on: a
+    median of three or more is not thrown by one such generation, nor by a slow one later
+    (the machine busy, the run paused).
     """
 
-    #: Generations measured (after the first) before an ETA is shown.
-    MIN_MEASURED = 2
+    #: Generations measured before an ETA is shown.
+    MIN_MEASURED = 3
 
     def __init__(self, quiet: bool, total: int) -> None:
         self.quiet = quiet
@@ -115,8 +115,7 @@ class _GenerationPrinter:
     def __call__(self, stats, settings) -> None:
         if self.quiet:
             return
-        first = not self.announced
-        if first:
+        if not self.announced:
             self.announced = True
             if stats.generation > 0:  # the first generation run here was not the run's first
                 print(
@@ -124,8 +123,7 @@ class _GenerationPrinter:
                     f"{self.total} are done",
                     file=sys.stderr,
                 )
-        else:
-            self.recent.append(stats.seconds)
+        self.recent.append(stats.seconds)
         print(
             f"generation {stats.generation + 1:>4}/{self.total}  best {stats.best:6.3f}  "
             f"mean {stats.mean:6.3f}  best so far {stats.best_so_far:6.3f}  "
