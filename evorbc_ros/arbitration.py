@@ -12,6 +12,7 @@ import numpy as np
 from evorbc_ros.arbitrator import Arbitrator, ArbitratorFile, DirectController
 from evorbc_ros.defaults import default_arbitrator, default_repertoire
 from evorbc_ros.laser import InputError
+from evorbc_ros.mapping import NO_PRIMITIVE
 from evorbc_ros.repertoire import Repertoire
 
 
@@ -66,13 +67,31 @@ class Controller:
     def step(self, inputs: np.ndarray) -> tuple[np.ndarray, list[float]]:
         """Genes to run and a diagnostic row ``[m1, m2, x, y, primitive]`` (EvoRBC).
 
+        When the network's outputs are not finite there is no primitive to run: the genes
+        are empty (``(0,)``, published as an empty message that stops the robot at once)
+        and the row holds the outputs, NaN for the point and ``NO_PRIMITIVE`` (-1).
+
         Raises:
             InputError: the wrong number of inputs.
         """
         if inputs.shape != (self.spec.sensors.n_inputs,):
             raise InputError(f"expected {self.spec.sensors.n_inputs} inputs, got {inputs.size}")
         if self.repertoire is None:
-            return self.direct.genes(inputs), []
-        index, m = self.arbitrator.choose(inputs)
-        x, y = self.arbitrator.mapping.point(m[0], m[1])
-        return self.repertoire.genes[index], [float(m[0]), float(m[1]), x, y, float(index)]
+            genes = self.direct.genes(inputs)
+            return (np.empty(0) if genes is None else genes), []
+        index, m, x, y = self.arbitrator.choose_point(inputs)
+        row = [float(m[0]), float(m[1]), x, y, float(index)]
+        if index == NO_PRIMITIVE:
+            return np.empty(0), row
+        return self.repertoire.genes[index], row
+
+    @staticmethod
+    def no_primitive_reason(inputs: np.ndarray, genes: np.ndarray, row: list[float]) -> str:
+        """Why :meth:`step` chose nothing, for the log ("" when it chose a primitive)."""
+        if len(genes):
+            return ""
+        what = f"outputs ({row[0]!r}, {row[1]!r})" if row else "outputs"
+        return (
+            f"the network's {what} are not finite or map to no finite point, for inputs "
+            f"{np.round(inputs, 3).tolist()}: no primitive, the robot stops"
+        )

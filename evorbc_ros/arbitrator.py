@@ -34,8 +34,9 @@ from typing import Any
 import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.input_files import ARBITRATOR_LIMIT
 from evorbc_ros.json_files import load_json_file
-from evorbc_ros.mapping import MAPPINGS, MappingFunction, PrimitiveLookup
+from evorbc_ros.mapping import MAPPINGS, MappingFunction, PrimitiveLookup, choose_primitive
 from evorbc_ros.network import NetworkError, NetworkSpec
 from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire, robot_problem
 from evorbc_ros.robots.primitive import ParameterSpec
@@ -96,7 +97,7 @@ class ArbitratorFile:
         Raises:
             ArbitratorError: one line naming the file and the problem.
         """
-        data = load_json_file(path, "arbitrator", ArbitratorError)
+        data = load_json_file(path, "arbitrator", ArbitratorError, ARBITRATOR_LIMIT)
         return cls.from_dict(data, str(path))
 
     @classmethod
@@ -332,10 +333,19 @@ class Arbitrator:
         return self.network.activate(inputs)
 
     def choose(self, inputs) -> tuple[int, np.ndarray]:
-        """The primitive to run next and the mapping values that chose it."""
+        """The primitive to run next and the mapping values that chose it.
+
+        The index is :data:`~evorbc_ros.mapping.NO_PRIMITIVE` when the outputs (or the
+        point they map to) are not finite: the robot must stop for the cycle.
+        """
         m = self.outputs(inputs)
-        x, y = self.mapping.point(m[0], m[1])
-        return self.lookup.nearest(x, y), m
+        return choose_primitive(self.mapping, self.lookup, m[0], m[1])[0], m
+
+    def choose_point(self, inputs) -> tuple[int, np.ndarray, float, float]:
+        """:meth:`choose` and the behaviour-space point ``(x, y)`` (m; NaN if none)."""
+        m = self.outputs(inputs)
+        index, x, y = choose_primitive(self.mapping, self.lookup, m[0], m[1])
+        return index, m, x, y
 
 
 class DirectController:
@@ -347,6 +357,13 @@ class DirectController:
         self.spec = spec
         self.network = spec.network.compile()
 
-    def genes(self, inputs) -> np.ndarray:
-        """Genes in [-1, 1] (one per locomotion parameter): sigmoid outputs mapped linearly."""
-        return 2.0 * np.clip(self.network.activate(inputs), 0.0, 1.0) - 1.0
+    def genes(self, inputs) -> np.ndarray | None:
+        """Genes in [-1, 1] (one per locomotion parameter): sigmoid outputs mapped linearly.
+
+        None when an output is not finite: no parameters to run, the robot must stop for
+        the cycle (as an EvoRBC arbitrator's :data:`~evorbc_ros.mapping.NO_PRIMITIVE`).
+        """
+        out = self.network.activate(inputs)
+        if not np.all(np.isfinite(out)):
+            return None
+        return 2.0 * np.clip(out, 0.0, 1.0) - 1.0

@@ -2,16 +2,35 @@
 
 Each write goes to a temporary file in the destination folder (same filesystem), is
 flushed to disk, and then renamed over the destination.
+
+* A writer killed outright (SIGKILL, power loss) cannot remove its temporary file. So each
+  temporary is named after its writer, ``.<name>.tmp-<host>-<pid>-<random><suffix>``, and
+  every write first removes the destination's temporaries whose writer was on this host
+  and is gone. Another live writer's file, or one from another host (a shared folder), is
+  never touched.
+* A failed write (disk full, quota, file too large) raises :class:`OSError` naming the
+  destination, not the hidden temporary: ``r.json: No space left on device``.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import socket
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO
+
+
+def _host() -> str:
+    """The host name, as it may appear in a file name (no ``/``)."""
+    return socket.gethostname().replace("/", "_") or "localhost"
+
+
+def _prefix(dest: Path) -> str:
+    """The start of every temporary file name of ``dest``."""
+    return f".{dest.name}.tmp-"
 
 
 @contextlib.contextmanager
@@ -20,23 +39,87 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
 
     For writers that insist on a file name (matplotlib, numpy). The temporary keeps the
     destination's suffix so that format detection by extension still works.
+
+    Raises:
+        OSError: from the system, with ``filename`` the destination (see module doc).
     """
     dest = Path(path)
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(
-        prefix=f".{dest.name}.", suffix=f".tmp{dest.suffix}", dir=dest.parent
-    )
-    os.close(fd)
-    tmp_path = Path(tmp)
-    # mkstemp creates 0600 files; give the result the permissions a plain open() would.
-    os.chmod(tmp_path, _default_mode(dest))
     try:
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        remove_stale_temporaries(dest)
+        fd, tmp = tempfile.mkstemp(
+            prefix=f"{_prefix(dest)}{_host()}-{os.getpid()}-",
+            suffix=dest.suffix,
+            dir=dest.parent,
+        )
+        os.close(fd)
+    except OSError as e:
+        raise _naming(e, dest) from None
+    tmp_path = Path(tmp)
+    try:
+        # mkstemp creates 0600 files; give the result the permissions a plain open() would.
+        os.chmod(tmp_path, _default_mode(dest))
         yield tmp_path
         with open(tmp_path, "rb+") as f:
             os.fsync(f.fileno())
         os.replace(tmp_path, dest)
+    except OSError as e:
+        raise _naming(e, dest) from None
     finally:
         tmp_path.unlink(missing_ok=True)
+
+
+def _naming(error: OSError, dest: Path) -> OSError:
+    """``error`` about ``dest``: the system's errors name the file the user asked for.
+
+    An error without an errno (raised by a writer's own code) is passed on as it is.
+    """
+    if error.errno is None:
+        return error
+    return OSError(error.errno, error.strerror or os.strerror(error.errno), str(dest))
+
+
+def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files of ``path`` left by writers that no longer run.
+
+    Only temporaries named by :func:`atomic_path` on this host whose process is gone are
+    removed; a live writer's (or a reused pid's) file is left, as is anything that does
+    not parse. Returns the files removed.
+    """
+    dest = Path(path)
+    prefix, host = _prefix(dest), _host()
+    removed = []
+    try:
+        names = os.listdir(dest.parent)
+    except OSError:
+        return removed
+    for name in names:
+        if not (name.startswith(prefix) and name.endswith(dest.suffix)):
+            continue
+        stem = name[len(prefix) :]
+        stem = stem[: len(stem) - len(dest.suffix)]
+        parts = stem.rsplit("-", 2)  # host (may hold "-"), pid, mkstemp's random part
+        if len(parts) != 3 or parts[0] != host or not parts[1].isdigit():
+            continue
+        if _alive(int(parts[1])):
+            continue
+        with contextlib.suppress(FileNotFoundError):  # another writer cleaned it first
+            (dest.parent / name).unlink()
+            removed.append(dest.parent / name)
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists on this host (ours counts: a write in progress)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True  # another user's process; or no pid at all: not ours to judge
+    return True
 
 
 def _default_mode(dest: Path) -> int:

@@ -22,6 +22,14 @@ from typing import Any
 
 import yaml
 
+from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular_text
+from evorbc_ros.json_files import find_value
+
+#: The largest integer a float can hold; a larger one cannot be any setting.
+_FLOAT_MAX_INT = int(sys.float_info.max)
+#: The largest integer setting (numpy's int64).
+INT_LIMIT = 2**63 - 1
+
 
 class ConfigError(ValueError):
     """A settings file or value is not valid; the message names the file and key."""
@@ -31,16 +39,12 @@ def load_yaml_mapping(path: str | os.PathLike) -> dict[str, Any]:
     """Read a YAML file whose top level is a mapping.
 
     Raises:
-        ConfigError: the file is missing, not YAML, or not a mapping.
+        ConfigError: the file is missing, not a regular file, too large, not UTF-8, not
+            YAML, or not a mapping.
 
     """
     source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError(f"{source}: no such settings file") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise ConfigError(f"{source}: cannot read ({e})") from None
+    text = read_regular_text(path, "settings", ConfigError, SETTINGS_LIMIT)
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as e:
@@ -56,6 +60,16 @@ def load_yaml_mapping(path: str | os.PathLike) -> dict[str, Any]:
     if not isinstance(data, dict):
         raise ConfigError(
             f"{source}: expected a mapping of settings at the top level, got {type(data).__name__}"
+        )
+    # YAML reads 10**400 exactly (a float that large reads as infinity, which settings
+    # refuse as not finite): no setting can hold it.
+    found = find_value(
+        data, lambda v: isinstance(v, int) and not isinstance(v, bool) and abs(v) > _FLOAT_MAX_INT
+    )
+    if found:
+        raise ConfigError(
+            f"{source}: {found[0]} is beyond float range (at most about 1.8e308): no setting "
+            "can hold it"
         )
     return data
 
@@ -81,6 +95,8 @@ def _check_value(name: str, value: Any, expected: Any, meta: dict, source: str) 
     elif expected is int:
         if isinstance(value, bool) or not isinstance(value, int):
             raise ConfigError(f"{source}: {name} must be an integer, got {value!r}")
+        if abs(value) > INT_LIMIT:  # numpy's int64 cannot hold it, nor any count we run
+            raise ConfigError(f"{source}: {name} must be at most {INT_LIMIT:,} in size")
     elif expected is bool:
         if not isinstance(value, bool):
             raise ConfigError(f"{source}: {name} must be true or false, got {value!r}")

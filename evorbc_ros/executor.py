@@ -6,6 +6,11 @@ its inputs last arrived; if the primitive or any sensor input is older than
 ``stale_timeout`` it commands zero wheel speed (steering held where it is) until they come
 back. Times are seconds on the node's clock (simulated or wall); if that clock goes back,
 everything is forgotten and the robot stops until a new primitive arrives.
+
+An empty primitive message is the arbitrator's "no primitive" (its network's outputs were
+not finite): the robot stops at once, as for stale inputs, until the next primitive. The
+offline episodes stop the same way for such a cycle, so a lockstep run still equals the
+offline replay cycle by cycle (DESIGN.md section 7).
 """
 
 from __future__ import annotations
@@ -16,6 +21,9 @@ import numpy as np
 
 from evorbc_ros.laser import InputError
 from evorbc_ros.robots.four_ws import FourWSGeometry, FourWSType
+
+#: Why the robot stands after an empty primitive message.
+NO_PRIMITIVE_REASON = "the arbitrator chose no primitive (its network's outputs are not finite)"
 
 
 @dataclass(frozen=True)
@@ -42,15 +50,23 @@ class InputWatch:
         self.last_seen: dict[str, float | None] = dict.fromkeys(["primitive", *inputs])
         self.first_event: float | None = None  # when the first input of any kind arrived
         self.genes: np.ndarray | None = None
+        self.halted = False  # the arbitrator's latest message was "no primitive"
 
     def on_primitive(self, genes, now: float) -> None:
-        """A new primitive from the arbitrator.
+        """A new primitive from the arbitrator; no genes at all means "no primitive".
 
         Raises:
             InputError: wrong number of genes, or values that are not finite or outside
                 [-1, 1] (the robot's genes map linearly onto its parameter ranges).
         """
         g = np.asarray(genes, dtype=np.float64)
+        if g.size == 0:
+            # The arbitrator is alive and says: stop now. The last genes are kept (the
+            # hexapod's gait clock and held targets need them) but not run.
+            self.check_clock(now)
+            self.halted = True
+            self.on_input("primitive", now)
+            return
         if g.shape != (self.n_parameters,):
             raise InputError(
                 f"primitive has {g.size} values, robot {self.robot_name} expects "
@@ -60,6 +76,7 @@ class InputWatch:
             raise InputError(f"primitive genes must be finite and in [-1, 1], got {g.tolist()}")
         self.check_clock(now)  # before taking the genes: a reset would drop them
         self.genes = g
+        self.halted = False
         self.on_input("primitive", now)
 
     def check_clock(self, now: float) -> bool:
@@ -79,6 +96,7 @@ class InputWatch:
         self.last_seen = dict.fromkeys(self.last_seen)
         self.first_event = None
         self.genes = None
+        self.halted = False
 
     def on_input(self, name: str, now: float) -> None:
         """A sensor input arrived (only its time matters here)."""
@@ -107,10 +125,12 @@ class InputWatch:
         """Why the robot must stand still now ("" if it may run the primitive)."""
         if self.check_clock(now):
             return "the clock went back: waiting for a new primitive"
-        if self.genes is None:
+        if self.genes is None and not self.halted:
             return "no primitive yet"
         stale = self.stale(now)
-        return f"stale input: {', '.join(stale)}" if stale else ""
+        if stale:
+            return f"stale input: {', '.join(stale)}"
+        return NO_PRIMITIVE_REASON if self.halted else ""
 
 
 class PrimitiveExecutor(InputWatch):

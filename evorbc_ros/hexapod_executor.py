@@ -13,8 +13,10 @@ The gait clock starts with the first primitive and counts whole physics steps,
 ``round((now - t0) / dt)``: a new primitive takes over at the current phase of the
 oscillators (as in the paper's simulation, where the gait time is the episode time), and
 the times are bit-identical to the offline simulation's. When the primitive or a sensor
-input is stale, the command holds the last targets: the legs stop where they are and the
-robot stands still.
+input is stale, or the arbitrator chose no primitive (an empty message: its network's
+outputs were not finite), the command holds the last targets: the legs stop where they are
+and the robot stands still. Before any target was sent there is none to hold; the node then
+sends an empty trajectory, ROS's "stop and hold where you are" (DESIGN.md section 7).
 """
 
 from __future__ import annotations
@@ -77,8 +79,14 @@ class HexapodExecutor(InputWatch):
         self.table = None
 
     def on_primitive(self, genes, now: float) -> None:
-        """A new primitive; the gait clock starts with the first one."""
+        """A new primitive; the gait clock starts with the first one.
+
+        An empty one ("no primitive") stops the gait: :meth:`command` then holds the
+        target being tracked, and the gait clock runs on for the next primitive.
+        """
         super().on_primitive(genes, now)
+        if self.halted:
+            return
         self.table = GaitTable(self.genes, self.geometry)
         if self.gait_start is None:
             self.gait_start = now

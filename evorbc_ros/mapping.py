@@ -11,8 +11,13 @@ behaviour is nearest that point runs next.
   repertoire. ``m2 = 0.5`` is straight ahead; ``m1 < 0.5`` goes backward.
 
 Primitive lookup is O(1): when the repertoire is loaded, a grid over the mapping's domain
-is filled with the index of each cell centre's nearest primitive (brute force, ties to the
-lower index), so a query only finds its cell.
+is filled with the index of each cell centre's nearest primitive (ties to the lower index),
+so a query only finds its cell. The grid is exactly what brute force over every primitive
+gives, built by pruning primitives that cannot be nearest to a block of cells
+(:func:`nearest_on_grid`), so it takes seconds, not minutes, for 200,000 primitives.
+
+A network output that is not finite (NaN or infinite), or a point that is not, chooses
+no primitive (:data:`NO_PRIMITIVE`): the robot stops for that cycle (DESIGN.md section 7).
 """
 
 from __future__ import annotations
@@ -23,6 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 MAPPINGS = ("polar", "cartesian")
+#: The "primitive index" of a cycle in which the network chose none (non-finite output).
+NO_PRIMITIVE = -1
 #: Cells per axis of the lookup grid (256 x 256: about 3 mm cells for a 0.36 m repertoire).
 DEFAULT_GRID_CELLS = 256
 
@@ -105,22 +112,122 @@ class PrimitiveLookup:
         wy = max(ymax - ymin, 1e-9) / cells
         cx = xmin + (np.arange(cells) + 0.5) * wx
         cy = ymin + (np.arange(cells) + 0.5) * wy
-        table = np.empty((cells, cells), dtype=np.int64)
-        for i in range(cells):  # one column at a time keeps memory at cells x n
-            d2 = (cx[i] - b[None, :, 0]) ** 2 + (cy[:, None] - b[None, :, 1]) ** 2
-            table[i] = np.argmin(d2, axis=1)
+        table = nearest_on_grid(b, cx, cy)
         return cls((xmin, ymin), (wx, wy), table)
 
     def cell_of(self, x: float, y: float) -> tuple[int, int]:
         """Grid cell of the point ``(x, y)``; points outside use the nearest border cell."""
         nx, ny = self.table.shape
-        i = min(max(math.floor((x - self.origin[0]) / self.cell[0]), 0), nx - 1)
-        j = min(max(math.floor((y - self.origin[1]) / self.cell[1]), 0), ny - 1)
-        return i, j
+        return (
+            clamped_cell((x - self.origin[0]) / self.cell[0], nx),
+            clamped_cell((y - self.origin[1]) / self.cell[1], ny),
+        )
 
     def nearest(self, x: float, y: float) -> int:
-        """Index of the primitive nearest ``(x, y)`` (exact at cell centres)."""
+        """Index of the primitive nearest ``(x, y)`` (exact at cell centres).
+
+        The point must be finite (see :func:`choose_primitive`).
+        """
         return int(self.table[self.cell_of(x, y)])
+
+
+def clamped_cell(f: float, n: int) -> int:
+    """Cell index ``floor(f)`` clamped to ``[0, n - 1]``; shared with numba code.
+
+    Clamped before ``floor``: a huge but finite ``f`` (1e300) has no int64 form in compiled
+    code, where converting it would be undefined, so both forms compare first.
+    """
+    if f < 0.0:
+        return 0
+    if f >= n:
+        return n - 1
+    return math.floor(f)
+
+
+def choose_primitive(
+    mapping: MappingFunction, lookup: PrimitiveLookup, m1: float, m2: float
+) -> tuple[int, float, float]:
+    """``(primitive index, x, y)`` for network outputs ``(m1, m2)``.
+
+    Non-finite outputs, or a point that overflows to infinity, choose no primitive:
+    ``(NO_PRIMITIVE, nan, nan)``. The robot then stops for the cycle (DESIGN.md section 7).
+    """
+    if not (math.isfinite(m1) and math.isfinite(m2)):
+        return NO_PRIMITIVE, math.nan, math.nan
+    x, y = mapping.point(m1, m2)
+    if not (math.isfinite(x) and math.isfinite(y)):
+        return NO_PRIMITIVE, math.nan, math.nan
+    return lookup.nearest(x, y), x, y
+
+
+#: Largest block of (cells x primitives) distances computed at once (2 MB of float64).
+_BLOCK = 1 << 18
+#: Relative slack of the pruning test: a primitive is dropped only if its lower bound
+#: exceeds the best upper bound by more than any rounding of the squared distances.
+_SLACK = 1e-9
+
+
+def nearest_on_grid(behaviour: np.ndarray, cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
+    """``(len(cx), len(cy))`` index of the primitive nearest each point ``(cx[i], cy[j])``.
+
+    Exactly brute force's answer (:func:`nearest_brute_force`, ties to the lower index):
+    the squared distances that decide are computed by the same formula, over every
+    primitive that could be nearest. A block of cells is split in four until few
+    primitives remain; a primitive is dropped from a block when its distance to the
+    block's rectangle exceeds the largest distance from that rectangle to some primitive
+    (by a relative slack far above rounding). Identical behaviours keep only the lowest
+    index (the same answer). ``cx`` and ``cy`` must be increasing.
+
+    Cost: about ``n`` per block level plus the final blocks' distances, a few seconds for
+    200,000 spread-out primitives on 256 x 256 cells (bench/bench_lookup.py).
+    """
+    b = np.asarray(behaviour, dtype=np.float64)
+    bx, by = b[:, 0], b[:, 1]
+    # Identical behaviours: only the lowest index can win a tie, so only it is kept.
+    order = np.lexsort((np.arange(len(b)), by, bx))  # by x, then y, then index
+    new = np.ones(len(b), dtype=bool)
+    new[1:] = (bx[order][1:] != bx[order][:-1]) | (by[order][1:] != by[order][:-1])
+    idx = np.sort(order[new])
+    table = np.empty((len(cx), len(cy)), dtype=np.int64)
+    stack = [(0, len(cx), 0, len(cy), idx)]
+    while stack:
+        i0, i1, j0, j1, idx = stack.pop()
+        px, py = bx[idx], by[idx]
+        qx, qy = cx[i0:i1], cy[j0:j1]
+        # Distance bounds between the block's rectangle of cell centres and each primitive.
+        gx = np.maximum(np.maximum(qx[0] - px, px - qx[-1]), 0.0)
+        gy = np.maximum(np.maximum(qy[0] - py, py - qy[-1]), 0.0)
+        fx = np.maximum(np.abs(px - qx[0]), np.abs(px - qx[-1]))
+        fy = np.maximum(np.abs(py - qy[0]), np.abs(py - qy[-1]))
+        upper = np.min(fx * fx + fy * fy)  # every cell has a primitive at most this far
+        keep = gx * gx + gy * gy <= upper * (1.0 + _SLACK)
+        idx, px, py = idx[keep], px[keep], py[keep]
+        n_cells = (i1 - i0) * (j1 - j0)
+        if n_cells * len(idx) <= _BLOCK or n_cells == 1 or len(idx) == 1:
+            table[i0:i1, j0:j1] = _nearest_block(qx, qy, px, py, idx)
+            continue
+        im, jm = (i0 + i1) // 2, (j0 + j1) // 2
+        for a, b_ in ((i0, im), (im, i1)):
+            for c, d in ((j0, jm), (jm, j1)):
+                if a < b_ and c < d:
+                    stack.append((a, b_, c, d, idx))
+    return table
+
+
+def _nearest_block(qx, qy, px, py, idx) -> np.ndarray:
+    """Brute force over candidates ``idx`` (increasing) for the cells ``qx x qy``.
+
+    The same formula as :func:`nearest_brute_force` and the original grid fill, so ties
+    and near-ties resolve bit for bit alike; chunked along x to bound memory.
+    """
+    out = np.empty((len(qx), len(qy)), dtype=np.int64)
+    rows = max(1, _BLOCK // max(1, len(qy) * len(idx)))
+    for s in range(0, len(qx), rows):
+        d2 = (qx[s : s + rows, None, None] - px[None, None, :]) ** 2 + (
+            qy[None, :, None] - py[None, None, :]
+        ) ** 2
+        out[s : s + rows] = idx[np.argmin(d2, axis=2)]
+    return out
 
 
 def nearest_brute_force(behaviour: np.ndarray, points: np.ndarray) -> np.ndarray:

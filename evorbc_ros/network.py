@@ -66,7 +66,9 @@ def _median(values: list[float]) -> float:
     n = len(values)
     if n <= 2:
         return sum(values) / n
-    v = sorted(values)
+    # NaN last, as numpy sorts (the compiled kernels): sorted() leaves it where it was.
+    finite = [x for x in values if x == x]
+    v = sorted(finite) + [math.nan] * (n - len(finite))
     return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2.0
 
 

@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write
-from evorbc_ros.json_files import first_difference
+from evorbc_ros.input_files import DATA_LIMIT, is_regular, read_regular
+from evorbc_ros.json_files import first_difference, parse_json
 
 _HEADER = "__header__"
 
@@ -65,31 +66,53 @@ def _header(data, source: str) -> dict:
     if _HEADER not in data.files:
         raise CheckpointError(f"{source}: not a checkpoint (no header)", discardable=False)
     try:
-        header = json.loads(str(data[_HEADER]))
+        text = str(data[_HEADER])
     except _READ_ERRORS as e:
         raise CheckpointError(
             f"{source}: not a checkpoint ({_reason(e)})", discardable=False
+        ) from None
+    try:
+        header = parse_json(text, f"{source}: header", "checkpoint", _NotJson, _bad)
+    except _NotJson:
+        raise CheckpointError(
+            f"{source}: not a checkpoint (its header is not JSON)", discardable=False
         ) from None
     if not isinstance(header, dict):
         raise CheckpointError(f"{source}: not a checkpoint (bad header)", discardable=False)
     return header
 
 
+class _NotJson(ValueError):
+    """The text is not JSON (the caller says what that makes the file)."""
+
+
+def _bad(message: str) -> CheckpointError:
+    """A checkpoint that holds a value no run writes (a number beyond float range)."""
+    return CheckpointError(message)
+
+
+def _not_ours(message: str) -> CheckpointError:
+    """The error for a file that is not recognisably a checkpoint: never to be deleted."""
+    return CheckpointError(message, discardable=False)
+
+
+def _read(path: str | os.PathLike) -> bytes:
+    """The bytes of a checkpoint file: a regular file of a sane size, else CheckpointError."""
+    return read_regular(path, "checkpoint", _not_ours, DATA_LIMIT)
+
+
 def _open(path: str | os.PathLike):
     """``np.load`` of a file that is an ``.npz`` archive, else CheckpointError."""
     source = str(path)
-    if not Path(path).exists():
-        raise CheckpointError(f"{source}: no such checkpoint", discardable=False)
-    if Path(path).is_dir():
-        raise CheckpointError(f"{source}: is a folder, expected a checkpoint", discardable=False)
+    data = io.BytesIO(_read(path))
     # Checked first: numpy reads any other file as a pickle and then complains about
     # allow_pickle, which says nothing useful about a JSON or text file.
-    if not zipfile.is_zipfile(path):
+    if not zipfile.is_zipfile(data):
         raise CheckpointError(
             f"{source}: not a checkpoint (not an .npz archive)", discardable=False
         )
     try:
-        return np.load(path, allow_pickle=False)
+        return np.load(data, allow_pickle=False)
     except _READ_ERRORS as e:
         raise CheckpointError(
             f"{source}: not a checkpoint ({_reason(e)})", discardable=False
@@ -122,10 +145,8 @@ def load_json_checkpoint(path: str | os.PathLike) -> dict:
 
     """
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
-    except OSError as e:
-        raise CheckpointError(f"{path}: cannot read ({e.strerror})", discardable=False) from None
-    except (UnicodeDecodeError, RecursionError, json.JSONDecodeError):
+        data = parse_json(_read(path).decode("utf-8"), str(path), "checkpoint", _NotJson, _bad)
+    except (UnicodeDecodeError, _NotJson):
         raise CheckpointError(f"{path}: not a checkpoint (not JSON)", discardable=False) from None
     if not isinstance(data, dict):
         raise CheckpointError(f"{path}: not a checkpoint (not a JSON object)", discardable=False)
@@ -134,6 +155,8 @@ def load_json_checkpoint(path: str | os.PathLike) -> dict:
 
 def checkpoint_kind(path: str | os.PathLike) -> str | None:
     """The ``kind`` a checkpoint (``.npz`` or JSON) declares; None for any other file."""
+    if not is_regular(path):
+        return None  # a folder, FIFO or device: opening it could block or never end
     try:
         if zipfile.is_zipfile(path):
             with _open(path) as data:

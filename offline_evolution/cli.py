@@ -23,12 +23,17 @@ from evorbc_ros.config import ConfigError
 from evorbc_ros.repertoire import RepertoireError
 from offline_evolution.checkpoint import CheckpointError
 from offline_evolution.commands import arbitrator, repertoire, replay
-from offline_evolution.commands.common import EXIT_ERROR, EXIT_INTERRUPTED, CliError
+from offline_evolution.commands.common import (
+    EXIT_ERROR,
+    EXIT_INTERRUPTED,
+    CliError,
+    OneLineParser,
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``evorbc-evolve``."""
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="evorbc-evolve",
         description="Offline evolution for EvoRBC: repertoires of locomotion primitives "
         "(MAP-Elites) and arbitrators (NEAT).",

@@ -179,7 +179,9 @@ class HexapodBridge:
                 f"{self.topic}: {problem}; ignored", throttle_duration_sec=2.0
             )
             return
-        self.trajectory, self.cursor = rows, 0
+        # An empty trajectory is ROS's "stop and hold where you are": the servos keep their
+        # last targets (what the executor sends when told to stop before any target).
+        self.trajectory, self.cursor = (rows if len(rows) else None), 0
         on_command("trajectory")
 
     def _targets(self, msg: JointTrajectory) -> tuple[str, np.ndarray | None]:
@@ -188,7 +190,7 @@ class HexapodBridge:
         if sorted(names) != sorted(JOINT_NAMES):
             return f"expected the 18 joints {', '.join(JOINT_NAMES)}, got {names}", None
         if not msg.points:
-            return "trajectory has no points", None
+            return "", np.empty((0, 18))  # "stop and hold where you are"
         order = [names.index(n) for n in JOINT_NAMES]
         times, rows = [], []
         for point in msg.points:

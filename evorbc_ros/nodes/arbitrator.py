@@ -13,8 +13,10 @@ than the ``robot`` parameter stop it at start-up with one line.
 from __future__ import annotations
 
 import json
+import math
 import sys
 
+import numpy as np
 from rclpy.node import Node
 from std_msgs.msg import Float64MultiArray
 
@@ -134,7 +136,12 @@ class ArbitratorNode(Node):
         )
 
     def on_input(self, topic: str, msg: Float64MultiArray) -> None:
-        """Store one input group; choose once all are new."""
+        """Store one input group; choose once all are new.
+
+        A network whose outputs are not finite chooses no primitive: an empty message on
+        the primitive topic stops the robot at once (the executor's rule), and the cycle
+        is logged. So is any other failure of the choice, which must never end the node.
+        """
         try:
             values = vector_values(msg, self.groups.sizes[topic], topic)
         except InputError as e:
@@ -142,12 +149,28 @@ class ArbitratorNode(Node):
             return
         if not self.groups.put(topic, values):
             return
-        genes, diagnostics = self.controller.step(self.groups.take())
-        self.pub.publish(vector_message(genes, self.controller.parameter_names))
+        inputs = self.groups.take()
+        try:
+            genes, diagnostics = self.controller.step(inputs)
+        except Exception as e:  # a controller bug must stop the robot, not the node
+            genes, diagnostics = np.empty(0), []
+            self.get_logger().error(
+                f"choosing a primitive failed ({type(e).__name__}: {e}); the robot stops",
+                throttle_duration_sec=2.0,
+            )
+        else:
+            reason = self.controller.no_primitive_reason(inputs, genes, diagnostics)
+            if reason:
+                self.get_logger().warning(reason, throttle_duration_sec=2.0)
+        names = self.controller.parameter_names if len(genes) else []
+        self.pub.publish(vector_message(genes, names))
         if diagnostics:
             self.map_pub.publish(vector_message(diagnostics, ["m1", "m2", "x", "y", "primitive"]))
         if self.record is not None:
-            self.record.write(json.dumps(diagnostics or list(map(float, genes))) + "\n")
+            row = diagnostics or list(map(float, genes))
+            # JSON has no NaN or infinity: a value outside float range is written as null.
+            row = [v if math.isfinite(v) else None for v in row]
+            self.record.write(json.dumps(row) + "\n")
 
     def destroy_node(self) -> None:
         """Close the record file, then the node."""

@@ -36,7 +36,7 @@ from rclpy.parameter import Parameter
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from evorbc_ros.executor import PrimitiveExecutor, WheelCommand
+from evorbc_ros.executor import NO_PRIMITIVE_REASON, PrimitiveExecutor, WheelCommand
 from evorbc_ros.hexapod_executor import HexapodExecutor, JointTargets
 from evorbc_ros.laser import InputError
 from evorbc_ros.nodes.common import (
@@ -175,7 +175,7 @@ class PrimitiveExecutorNode(Node):
         self.on_primitive(msg)
 
     def on_primitive(self, msg: Float64MultiArray) -> None:
-        """Run a new primitive at once."""
+        """Run a new primitive at once; an empty message stops the robot at once."""
         now = now_seconds(self)
         try:
             self.logic.on_primitive(msg.data, now)
@@ -184,7 +184,12 @@ class PrimitiveExecutorNode(Node):
                 f"{self.primitive_topic}: skipped: {e}", throttle_duration_sec=2.0
             )
             return
-        self.publish(self.logic.command(now), now)
+        command = self.logic.command(now)
+        if self.logic.halted and isinstance(command, JointTargets) and not len(command.positions):
+            # No target sent yet, so none to hold: an empty trajectory is ROS's "stop and
+            # hold where you are" for a joint trajectory controller.
+            self.trajectory_pub.publish(JointTrajectory(joint_names=list(JOINT_NAMES)))
+        self.publish(command, now)
 
     def on_input(self, topic: str) -> None:
         """Note a sensor input; if the robot was stopped for it, run again at once."""
@@ -201,7 +206,11 @@ class PrimitiveExecutorNode(Node):
             return  # never commanded: leave the controllers to whoever drives them (teleop)
         now = now_seconds(self)
         command = self.logic.command(now)
-        if command.stopped or now - self.last_publish > 1.5 * self.period:
+        # A stop for stale inputs is repeated every tick. The arbitrator's own "no
+        # primitive" stop was sent at once and is kept alive like a running primitive, so
+        # in lockstep every command still answers one arbitrator decision.
+        repeat = command.stopped and command.reason != NO_PRIMITIVE_REASON
+        if repeat or now - self.last_publish > 1.5 * self.period:
             self.publish(command, now)
 
     def publish(self, command: WheelCommand | JointTargets, now: float) -> None:

@@ -27,6 +27,8 @@ import numpy as np
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.config import ConfigError
+from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular
 from evorbc_ros.network import ConnectionSpec, NetworkSpec, NodeSpec
 from evorbc_ros.repertoire import Repertoire, RepertoireError
 from offline_evolution.arbitrator.neat_config import load_neat_config
@@ -148,9 +150,13 @@ def network_spec(genome, config: neat.Config) -> NetworkSpec:
     )
 
 
-def file_sha256(path: str | os.PathLike) -> str:
-    """SHA-256 of a file's bytes."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+def file_sha256(path: str | os.PathLike, what: str = "NEAT settings") -> str:
+    """SHA-256 of a settings file's bytes (a regular file, see :mod:`evorbc_ros.input_files`).
+
+    Raises:
+        ConfigError: the file is missing, not a regular file or too large.
+    """
+    return hashlib.sha256(read_regular(path, what, ConfigError, SETTINGS_LIMIT)).hexdigest()
 
 
 class Evolution:

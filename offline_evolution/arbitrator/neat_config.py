@@ -6,12 +6,14 @@ import configparser
 import io
 import math
 import os
+import reprlib
 import tempfile
 from pathlib import Path
 
 import neat
 
-from evorbc_ros.config import ConfigError, config_dir
+from evorbc_ros.config import INT_LIMIT, ConfigError, config_dir
+from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular_text
 from evorbc_ros.network import ACTIVATIONS, AGGREGATIONS
 from offline_evolution.arbitrator.neat_classes import EvoRBCGenome, TargetSpeciesSet
 
@@ -23,6 +25,14 @@ INITIAL_CONNECTIONS = (
 )  # fmt: skip
 #: species_fitness_func values neat-python's stagnation knows.
 SPECIES_FITNESS = ("max", "min", "mean", "median")
+#: fitness_criterion values neat-python's population knows.
+FITNESS_CRITERIA = ("max", "min", "mean")
+#: *_init_type values neat-python's float attributes draw from (others fail mid-run).
+INIT_TYPES = ("gaussian", "gauss", "normal", "uniform")
+#: Settings that are spreads, powers, counts or weights: a negative one makes neat-python
+#: draw from nothing, never stagnate or speciate backwards.
+NON_NEGATIVE_SUFFIXES = ("_stdev", "_mutate_power", "_coefficient")
+NON_NEGATIVE = ("num_hidden", "species_elitism", "max_stagnation", "elitism")
 
 
 def default_neat_file(robot: str) -> Path:
@@ -40,12 +50,10 @@ def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int)
     """
     source = str(path)
     parser = configparser.ConfigParser()
+    text = read_regular_text(path, "NEAT settings", ConfigError, SETTINGS_LIMIT)
     try:
-        with open(path, encoding="utf-8") as f:
-            parser.read_file(f)
-    except FileNotFoundError:
-        raise ConfigError(f"{source}: no such NEAT settings file") from None
-    except (OSError, UnicodeDecodeError, configparser.Error) as e:
+        parser.read_string(text, source)
+    except configparser.Error as e:
         first = str(e).strip().splitlines()[0]
         raise ConfigError(f"{source}: not a valid NEAT settings file ({first})") from None
     if not parser.has_section(GENOME_SECTION):
@@ -91,6 +99,27 @@ def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int)
     return config
 
 
+def _check_neat_section(config: neat.Config, parser: configparser.ConfigParser, source: str):
+    """[NEAT]: a known fitness criterion and a finite threshold (neat-python checks neither).
+
+    Raises:
+        ConfigError: ``FILE: [NEAT] key ...`` in one line.
+    """
+    if config.pop_size > INT_LIMIT:
+        raise ConfigError(f"{source}: [NEAT] pop_size must be at most {INT_LIMIT:,}")
+    criterion = parser["NEAT"].get("fitness_criterion", "max").strip()
+    if criterion not in FITNESS_CRITERIA:
+        raise ConfigError(
+            f"{source}: [NEAT] fitness_criterion must be one of {', '.join(FITNESS_CRITERIA)}, "
+            f"got {criterion!r}"
+        )
+    if not math.isfinite(config.fitness_threshold):
+        raise ConfigError(
+            f"{source}: [NEAT] fitness_threshold must be a finite number, got "
+            f"{parser['NEAT'].get('fitness_threshold')}"
+        )
+
+
 def _check_limits(genome: configparser.SectionProxy, source: str) -> None:
     """Refuse a min above its max (neat-python's own message names no key)."""
     for attr in ("bias", "response", "weight"):
@@ -134,9 +163,28 @@ def _check_values(config: neat.Config, parser: configparser.ConfigParser, source
             except ValueError:
                 continue  # words (sigmoid, gaussian, ...): neat-python checked them
             if not math.isfinite(value):
-                raise ConfigError(f"{where} must be a finite number, got {text}")
+                raise ConfigError(f"{where} must be a finite number, got {reprlib.repr(text)}")
             if key.endswith(("_prob", "_rate", "_probability", "_add")) and not 0 <= value <= 1:
                 raise ConfigError(f"{where} is a probability and must be in [0, 1], got {text}")
+            if (key.endswith(NON_NEGATIVE_SUFFIXES) or key in NON_NEGATIVE) and value < 0:
+                raise ConfigError(f"{where} must be >= 0, got {text}")
+        for key in (k for k in parser[name] if k.endswith("_init_type")):
+            if getattr(cfg, key, None) not in INIT_TYPES:
+                raise ConfigError(
+                    f"{source}: [{name}] {key} must be one of {', '.join(INIT_TYPES)}, "
+                    f"got {getattr(cfg, key, None)!r}"
+                )
+    _check_neat_section(config, parser, source)
+    g = config.genome_config
+    for what, default, known in (
+        ("activation", g.activation_default, ACTIVATIONS),
+        ("aggregation", g.aggregation_default, AGGREGATIONS),
+    ):
+        if default not in known and default not in ("random", "none"):
+            raise ConfigError(
+                f"{source}: [{GENOME_SECTION}] {what}_default {default!r} is not supported; "
+                f"use one of {', '.join(known)} (or random)"
+            )
     pop, rep, spc = config.pop_size, config.reproduction_config, config.species_set_config
     checks = (
         (pop >= 2, "[NEAT] pop_size must be at least 2", pop),
@@ -154,6 +202,9 @@ def _check_values(config: neat.Config, parser: configparser.ConfigParser, source
          spc.threshold_min),
         (spc.threshold_step >= 0, "[TargetSpeciesSet] threshold_step must be >= 0",
          spc.threshold_step),
+        (config.stagnation_config.max_stagnation >= 1,
+         "[DefaultStagnation] max_stagnation must be >= 1 (generations)",
+         config.stagnation_config.max_stagnation),
         (config.stagnation_config.species_fitness_func in SPECIES_FITNESS,
          f"[DefaultStagnation] species_fitness_func must be one of {', '.join(SPECIES_FITNESS)}",
          config.stagnation_config.species_fitness_func),

@@ -245,6 +245,11 @@ def population_from_dict(data: dict, config: neat.Config) -> neat.Population:
     config.genome_config.innovation_tracker = tracker
     nxt = data["next_node_key"]
     config.genome_config.node_indexer = None if nxt is None else count(nxt)
-    version, internal, gauss = data["random_state"]
-    random.setstate((version, tuple(internal), gauss))
+    try:
+        version, internal, gauss = data["random_state"]
+        random.setstate((version, tuple(internal), gauss))
+    except (OverflowError, TypeError, ValueError) as e:  # numbers no generator holds
+        raise ValueError(
+            f"population.random_state is not a random generator's state ({e})"
+        ) from None
     return pop

@@ -8,18 +8,17 @@ import sys
 from collections import deque
 from pathlib import Path
 
-from evorbc_ros.repertoire import Repertoire
-from offline_evolution.checkpoint import CheckpointError, Interrupted
+from evorbc_ros.cli_support import check_output_file
+from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire
 from offline_evolution.commands.common import (
-    EXIT_INTERRUPTED,
-    CliError,
-    StopOnSignal,
     add_workers_option,
+    at_least,
     check_distinct,
-    check_writable,
     count,
     default_checkpoint,
+    exclusive_outputs,
     restart_from_scratch,
+    running,
     write_then_discard,
 )
 
@@ -27,7 +26,7 @@ from offline_evolution.commands.common import (
 def _common_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--generations",
-        type=count,
+        type=at_least(1),
         metavar="N",
         help="NEAT generations (default: config/arbitrator/<family>.yaml, Table I)",
     )
@@ -95,15 +94,23 @@ def add_parsers(sub) -> None:
 
 
 class _GenerationPrinter:
-    """One line per generation on stderr."""
+    """One line per generation on stderr, with an ETA once it means something.
+
+    The first generation a process runs also compiles the simulation kernels (seconds
+    where a generation then takes a fraction of one). The ETA is the median of the last
+    ten generations times those left, shown from the third generation measured on: a
+    median of three or more is not thrown by one such generation, nor by a slow one later
+    (the machine busy, the run paused).
+    """
+
+    #: Generations measured before an ETA is shown.
+    MIN_MEASURED = 3
 
     def __init__(self, quiet: bool, total: int) -> None:
         self.quiet = quiet
         self.total = total
         self.announced = False
-        # The ETA uses the median of recent generations (s), so one slow generation (the
-        # machine busy, the run paused) does not make it jump tenfold.
-        self.recent: deque[float] = deque(maxlen=10)
+        self.recent: deque[float] = deque(maxlen=10)  # s per generation
 
     def __call__(self, stats, settings) -> None:
         if self.quiet:
@@ -117,29 +124,65 @@ class _GenerationPrinter:
                     file=sys.stderr,
                 )
         self.recent.append(stats.seconds)
-        remaining = (self.total - stats.generation - 1) * statistics.median(self.recent)
         print(
             f"generation {stats.generation + 1:>4}/{self.total}  best {stats.best:6.3f}  "
             f"mean {stats.mean:6.3f}  best so far {stats.best_so_far:6.3f}  "
             f"species {stats.species:>2}  reached {stats.best_reached}  "
-            f"{stats.seconds:5.2f} s/gen  eta {remaining / 60:5.1f} min",
+            f"{stats.seconds:5.2f} s/gen  {self.eta(stats.generation + 1)}",
             file=sys.stderr,
+        )
+
+    def eta(self, done: int) -> str:
+        """``eta N.N min`` for the generations left, or ``eta --`` until it is meaningful."""
+        if done >= self.total:
+            return "done"
+        if len(self.recent) < self.MIN_MEASURED:
+            return "eta   --"
+        remaining = (self.total - done) * statistics.median(self.recent)
+        return f"eta {remaining / 60:5.1f} min"
+
+
+def _run(args, settings, every: int, repertoire, checkpoint: Path):
+    """Evolve (resuming from ``checkpoint``); the :class:`EvolutionResult`."""
+    from offline_evolution.arbitrator.evolve import CHECKPOINT_KIND, evolve
+
+    if args.restart:
+        restart_from_scratch(checkpoint, CHECKPOINT_KIND, "NEAT evolution checkpoint")
+    with running("generation", "generation") as stop:
+        return evolve(
+            settings,
+            repertoire,
+            checkpoint=checkpoint,
+            checkpoint_every=every,
+            progress=_GenerationPrinter(args.quiet, settings.generations),
+            should_stop=stop,
+            workers=args.workers or None,
+            repertoire_source=args.repertoire if repertoire else "the repertoire",
+            keep_checkpoint=True,  # deleted only once the files are written
         )
 
 
 def cmd_evolve(args: argparse.Namespace) -> int:
     """Evolve an arbitrator or a standard-NEAT controller and write its file and curve."""
+    from evorbc_ros.config import config_dir
+    from evorbc_ros.sensors import SensorLayout
     from offline_evolution.arbitrator.evolve import (
-        CHECKPOINT_KIND,
         EQUAL_BUDGET_GENERATIONS,
         EvolutionSettings,
         arbitrator_file,
-        evolve,
         file_sha256,
     )
+    from offline_evolution.arbitrator.neat_config import load_neat_config
     from offline_evolution.arbitrator.settings import load_run_settings
     from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+    from offline_evolution.memory import check_evolution_memory
 
+    out = Path(args.out)
+    plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")
+    checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.json")
+    # Every output is checked before any work, so that a typo costs nothing.
+    check_output_file(str(out), "--out")
+    check_output_file(str(plot), "--plot" if args.plot else "the default --plot", picture=True)
     repertoire = None
     if args.kind == "evorbc":
         repertoire = Repertoire.load(args.repertoire)
@@ -148,14 +191,10 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         robot = args.robot
     run = load_run_settings(args.config, robot)
     generations = args.generations if args.generations is not None else run.generations
-    if generations < 1:
-        raise CliError("--generations must be at least 1")
     if args.kind == "standard" and args.equal_budget:
         generations += EQUAL_BUDGET_GENERATIONS["hexapod" if robot == "hexapod" else "4ws"]
     neat_file = Path(args.neat_config) if args.neat_config else run.neat_path()
     task_settings = MazeTaskSettings.load(args.task or run.task_path())
-    if not neat_file.exists():
-        raise CliError(f"{neat_file}: no such NEAT settings file")
     settings = EvolutionSettings(
         kind=args.kind,
         robot=robot,
@@ -168,9 +207,6 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
         **run.selection(),
     )
-    out = Path(args.out)
-    plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")
-    checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.json")
     check_distinct(
         {
             "--out": out,
@@ -182,54 +218,41 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             "--task": args.task,
         }
     )
-    if args.restart:
-        restart_from_scratch(checkpoint, CHECKPOINT_KIND, "NEAT evolution checkpoint")
-    check_writable(out, plot)
+    # The NEAT settings and the task's memory, before any work.
+    layout = SensorLayout.load(config_dir() / task_settings.sensors)
+    n_outputs = 2 if args.kind == "evorbc" else ROBOT_PARAMETERS[robot]
+    pop_size = load_neat_config(neat_file, layout.n_inputs, n_outputs).pop_size
+    check_evolution_memory(
+        task_settings,
+        pop_size,
+        robot,
+        str(args.task or run.task_path()),
+        3 * run.hall_of_fame,
+        run.post_samples,
+    )
     every = args.checkpoint_every or run.checkpoint_every
-    stop = StopOnSignal("generation")
-    previous = stop.install()
-    try:
-        result = evolve(
-            settings,
-            repertoire,
-            checkpoint=checkpoint,
-            checkpoint_every=every,
-            progress=_GenerationPrinter(args.quiet, generations),
-            should_stop=stop,
-            workers=args.workers or None,
-            repertoire_source=args.repertoire if repertoire else "the repertoire",
-            keep_checkpoint=True,  # deleted only once the files below are written
-        )
-    except CheckpointError as e:
-        if e.discardable:
-            raise CliError(f"{e}; use --restart to discard it") from None
-        raise CliError(f"{e}; choose another --checkpoint") from None
-    except Interrupted as e:
-        raise CliError(
-            f"interrupted after generation {e.iteration}; finished work is saved "
-            f"in {e.checkpoint}; run the same command again to resume",
-            EXIT_INTERRUPTED,
-        ) from None
-    finally:
-        stop.restore(previous)
+    with exclusive_outputs({"--out": out, "--checkpoint": args.checkpoint}):
+        result = _run(args, settings, every, repertoire, checkpoint)
 
-    def write() -> None:
-        task = make_task(task_settings, robot, workers=1)
-        try:
-            arb = arbitrator_file(result, task, repertoire, args.repertoire if repertoire else None)
-            arb.save(out)
-        finally:
-            task.close()
-        from offline_evolution.plots.fitness import plot_fitness_history
+        def write() -> None:
+            task = make_task(task_settings, robot, workers=1)
+            try:
+                arb = arbitrator_file(
+                    result, task, repertoire, args.repertoire if repertoire else None
+                )
+                arb.save(out)
+            finally:
+                task.close()
+            from offline_evolution.plots.fitness import plot_fitness_history
 
-        plot_fitness_history(
-            result.history,
-            plot,
-            title=f"{'EvoRBC' if args.kind == 'evorbc' else 'standard NEAT'}, "
-            f"{robot}, seed {args.seed}",
-        )
+            plot_fitness_history(
+                result.history,
+                plot,
+                title=f"{'EvoRBC' if args.kind == 'evorbc' else 'standard NEAT'}, "
+                f"{robot}, seed {args.seed}",
+            )
 
-    write_then_discard(checkpoint, write)
+        write_then_discard(checkpoint, write)
     label = "arbitrator" if args.kind == "evorbc" else "standard-NEAT controller"
     post = result.post_evaluation
     print(

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import fcntl
 import math
 import os
 import signal
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 EXIT_ERROR = 1
@@ -21,6 +23,36 @@ class CliError(Exception):
     def __init__(self, message: str, code: int = EXIT_ERROR) -> None:
         super().__init__(message)
         self.code = code
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (no usage block) and status 2.
+
+    Every bad option value ends the same way, whether the parser or a later check finds
+    it: ``evorbc-evolve arbitrator: error: argument --generations: expected an integer
+    >= 1, got '0'``; ``--help`` shows the usage.
+    """
+
+    def error(self, message: str):
+        """Print one line and exit with the usage status."""
+        text = " ".join(message.split())
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {text} (see {self.prog} --help)\n")
+
+
+def at_least(low: int):
+    """Argparse type: an integer >= ``low``."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {text!r}")
+        return value
+
+    parse.__name__ = f"integer >= {low}"
+    return parse
 
 
 def positive_float(text: str) -> float:
@@ -77,6 +109,34 @@ class StopOnSignal:
             signal.signal(sig, old)
 
 
+@contextlib.contextmanager
+def running(step: str, unit: str) -> Iterator[StopOnSignal]:
+    """A long run's frame: Ctrl-C finishes the current ``step``; errors become one line.
+
+    Yields the :class:`StopOnSignal` to poll. A checkpoint that cannot be used, and the
+    interruption (status 130), end as :class:`CliError` saying what to do next; ``unit``
+    names what the run counts ("iteration", "generation").
+    """
+    from offline_evolution.checkpoint import CheckpointError, Interrupted
+
+    stop = StopOnSignal(step)
+    previous = stop.install()
+    try:
+        yield stop
+    except CheckpointError as e:
+        if e.discardable:
+            raise CliError(f"{e}; use --restart to discard it") from None
+        raise CliError(f"{e}; choose another --checkpoint") from None
+    except Interrupted as e:
+        raise CliError(
+            f"interrupted after {unit} {e.iteration}; finished work is saved in "
+            f"{e.checkpoint}; run the same command again to resume",
+            EXIT_INTERRUPTED,
+        ) from None
+    finally:
+        stop.restore(previous)
+
+
 def add_workers_option(parser: argparse.ArgumentParser) -> None:
     """``--workers N``: processes for PyBullet simulations (results do not depend on it)."""
     parser.add_argument(
@@ -86,22 +146,6 @@ def add_workers_option(parser: argparse.ArgumentParser) -> None:
         help="worker processes for robots simulated in PyBullet (default: one per core); "
         "results are the same for any number",
     )
-
-
-def check_writable(*paths) -> None:
-    """Fail early (before a long run) if an output folder cannot be created or written."""
-    for p in paths:
-        if p is None:
-            continue
-        folder = Path(p).resolve().parent
-        try:
-            folder.mkdir(parents=True, exist_ok=True)
-        except OSError as e:
-            raise CliError(f"{p}: cannot create folder {folder} ({e.strerror})") from None
-        if not os.access(folder, os.W_OK):
-            raise CliError(f"{p}: folder {folder} is not writable")
-        if Path(p).is_dir():
-            raise CliError(f"{p}: is a folder, expected a file name")
 
 
 def default_checkpoint(out: Path, given: str | None, suffix: str) -> Path:
@@ -164,3 +208,82 @@ def restart_from_scratch(checkpoint: Path, kind: str, what: str) -> None:
             f"{e}, so --restart does not delete it; remove it yourself or choose "
             "another --checkpoint"
         ) from None
+
+
+def lock_file(path: str | os.PathLike) -> Path:
+    """The lock file of an output: ``.<name>.lock`` next to it."""
+    path = Path(path)
+    return path.with_name(f".{path.name}.lock")
+
+
+@contextlib.contextmanager
+def exclusive_outputs(files: dict[str, str | os.PathLike | None]) -> Iterator[None]:
+    """Hold an OS lock on each of ``files`` (option -> path; None skipped) for a run.
+
+    Two runs given the same ``--out`` would share one checkpoint, and the last to write
+    would win; the second is refused while the first runs. The lock (``flock`` on
+    :func:`lock_file`) belongs to the process, so the system releases it when the process
+    ends in any way, SIGKILL included: a killed run never blocks the next one. The lock
+    file is removed when the run ends normally.
+
+    Raises:
+        CliError: naming the option, the file and the running process.
+    """
+    with contextlib.ExitStack() as stack:
+        for option, path in files.items():
+            if path is not None:
+                stack.enter_context(_locked(Path(path), option))
+        yield
+
+
+@contextlib.contextmanager
+def _locked(path: Path, option: str) -> Iterator[None]:
+    lock = lock_file(path)
+    try:
+        lock.parent.mkdir(parents=True, exist_ok=True)
+        fd = _acquire(lock, path, option)
+    except OSError as e:
+        raise CliError(f"{option} {path}: cannot lock {lock} ({e.strerror})") from None
+    try:
+        yield
+    finally:
+        # Removed while still held: a run that opened it meanwhile sees it gone and
+        # retries with a new file rather than taking a lock nobody else will check.
+        with contextlib.suppress(OSError):
+            lock.unlink()
+        os.close(fd)
+
+
+def _acquire(lock: Path, path: Path, option: str, tries: int = 20) -> int:
+    """An open, locked descriptor of ``lock`` that is still the file at that path."""
+    for _ in range(tries):
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.read(fd, 32).decode(errors="replace").strip()
+            held = _same_file(lock, fd)
+            os.close(fd)
+            if held:
+                who = f" (pid {holder})" if holder.isdigit() else ""
+                raise CliError(
+                    f"{option} {path}: another run{who} is writing it; wait for it to "
+                    f"finish or choose another {option}"
+                ) from None
+            continue  # its holder was just removing it: try again with the new file
+        if _same_file(lock, fd):
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()}\n".encode())
+            return fd
+        os.close(fd)  # removed by a run that ended between our open and our lock
+    raise CliError(f"{option} {path}: cannot lock {lock}: it keeps changing")
+
+
+def _same_file(lock: Path, fd: int) -> bool:
+    """Whether the path ``lock`` still names the file open as ``fd``."""
+    try:
+        st = os.stat(lock)
+    except FileNotFoundError:
+        return False
+    fst = os.fstat(fd)
+    return (st.st_dev, st.st_ino) == (fst.st_dev, fst.st_ino)

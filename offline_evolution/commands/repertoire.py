@@ -7,19 +7,18 @@ import sys
 import time
 from pathlib import Path
 
-from evorbc_ros.repertoire import Repertoire
-from offline_evolution.checkpoint import CheckpointError, Interrupted
+from evorbc_ros.cli_support import check_output_file
+from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire
 from offline_evolution.commands.common import (
-    EXIT_INTERRUPTED,
     CliError,
-    StopOnSignal,
     add_workers_option,
     check_distinct,
-    check_writable,
     count,
     default_checkpoint,
+    exclusive_outputs,
     positive_float,
     restart_from_scratch,
+    running,
     write_then_discard,
 )
 
@@ -99,13 +98,22 @@ def add_parsers(sub) -> None:
 
 
 class _ProgressPrinter:
-    """Prints a progress line to stderr at most every ``interval`` seconds, and the last."""
+    """Prints a progress line to stderr at most every ``interval`` seconds, and the last.
+
+    The rate and ETA leave out the first batch a process runs, which also compiles the
+    simulation kernels (or starts the workers): they come from the batches after it, and
+    the ETA is shown once those have run for :attr:`MIN_SECONDS` (``eta --`` before).
+    """
+
+    #: Seconds of batches after the first before the ETA is shown.
+    MIN_SECONDS = 2.0
 
     def __init__(self, quiet: bool, interval: float = 1.0) -> None:
         self.quiet = quiet
         self.interval = interval
         self.last = -float("inf")
         self.announced = False
+        self.after_first: tuple[float, int] | None = None  # (s, evaluations) after batch 1
 
     def __call__(self, p) -> None:
         if self.quiet:
@@ -113,19 +121,35 @@ class _ProgressPrinter:
         if p.resumed_from is not None and not self.announced:
             print(f"resuming from the checkpoint at iteration {p.resumed_from}", file=sys.stderr)
         self.announced = True
+        if self.after_first is None:
+            self.after_first = (p.elapsed, p.evaluations)
         now = time.perf_counter()
         if now - self.last < self.interval and p.iteration < p.iterations:
             return
         self.last = now
-        rate = p.rate
+        rate, eta = self.rate_and_eta(p)
         speed = f"{rate / 1e3:7.0f}k eval/s" if rate >= 1e4 else f"{rate:7.1f} eval/s"
-        eta = f"  eta {p.eta / 60:6.1f} min" if rate < 1e4 and p.eta != float("inf") else ""
         print(
             f"iteration {p.iteration:>5}/{p.iterations}  evaluations {p.evaluations:>9,}  "
             f"primitives {p.cells:>5}  mean quality {p.mean_quality:.3f}  "
             f"QD-score {p.qd_score:8.1f}  {speed}{eta}",
             file=sys.stderr,
         )
+
+    def rate_and_eta(self, p) -> tuple[float, str]:
+        """Evaluations/s and the ETA text (empty for fast runs, done in moments).
+
+        The rate is measured after the first batch (this process's overall rate until
+        then); the ETA waits for :attr:`MIN_SECONDS` of such batches.
+        """
+        t0, e0 = self.after_first
+        seconds, done = p.elapsed - t0, p.evaluations - e0
+        rate = done / seconds if seconds > 0 and done > 0 else p.rate
+        if rate >= 1e4 or p.evaluations >= p.total_evaluations:
+            return rate, ""
+        if seconds < self.MIN_SECONDS or done <= 0:
+            return rate, "  eta   --"
+        return rate, f"  eta {(p.total_evaluations - p.evaluations) / rate / 60:6.1f} min"
 
 
 #: Setting key -> the option that overrides it.
@@ -145,13 +169,8 @@ OPTIONS = {
 
 def cmd_repertoire(args: argparse.Namespace) -> int:
     """Generate a repertoire, write it (and optionally a plot and CSV), print a summary."""
-    from offline_evolution.repertoire.map_elites import CHECKPOINT_KIND, generate_repertoire
-    from offline_evolution.repertoire.settings import (
-        SettingError,
-        blame,
-        load_settings,
-        settings_path,
-    )
+    from offline_evolution.memory import check_repertoire_memory
+    from offline_evolution.repertoire.settings import load_settings, settings_path
 
     out = Path(args.out)
     checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.npz")
@@ -164,49 +183,23 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
             "--config": args.config,
         }
     )
+    # Every output is checked before any work, so that a typo costs nothing.
+    check_output_file(str(out), "--out")
+    if args.plot:
+        check_output_file(args.plot, "--plot", picture=True)
+    if args.csv:
+        check_output_file(args.csv, "--csv")
     given = {key: option for key, option in OPTIONS.items() if getattr(args, key) is not None}
     config = settings_path(args.config, args.robot)
     settings = load_settings(config, options=given, **{k: getattr(args, k) for k in OPTIONS})
-    check_writable(out, args.plot, args.csv)
-    if args.restart:
-        restart_from_scratch(checkpoint, CHECKPOINT_KIND, "MAP-Elites checkpoint")
-    stop = StopOnSignal("batch")
-    previous_handlers = stop.install()
-    start = time.perf_counter()
-    try:
-        repertoire = generate_repertoire(
-            settings,
-            checkpoint=checkpoint,
-            checkpoint_every=args.checkpoint_every,
-            progress=_ProgressPrinter(args.quiet),
-            should_stop=stop,
-            workers=args.workers or None,
-            keep_checkpoint=True,
-        )
-    except SettingError as e:
-        raise blame(e, config, given) from None
-    except CheckpointError as e:
-        if e.discardable:
-            raise CliError(f"{e}; use --restart to discard it") from None
-        raise CliError(f"{e}; choose another --checkpoint") from None
-    except Interrupted as e:
-        raise CliError(
-            f"interrupted after iteration {e.iteration}; finished work is saved in "
-            f"{e.checkpoint}; run the same command again to resume",
-            EXIT_INTERRUPTED,
-        ) from None
-    finally:
-        stop.restore(previous_handlers)
-    elapsed = time.perf_counter() - start
-    if len(repertoire) == 0:
-        # A repertoire without primitives could drive nothing (and would not load).
-        checkpoint.unlink(missing_ok=True)
-        raise CliError(
-            f"no primitive was kept after {repertoire.algorithm['evaluations']:,} evaluations "
-            "(each one left the archive's range or was discarded); nothing written to "
-            f"{out}; try a larger budget or another --metric"
-        )
-    write_then_discard(checkpoint, lambda: _write(repertoire, out, args.plot, args.csv))
+    check_repertoire_memory(
+        settings,
+        ROBOT_PARAMETERS[settings.robot],
+        lambda key: given.get(key) or f"{config}: {key}",
+    )
+    with exclusive_outputs({"--out": out, "--checkpoint": args.checkpoint}):
+        repertoire, elapsed = _run(args, settings, config, given, checkpoint)
+        write_then_discard(checkpoint, lambda: _write(repertoire, out, args.plot, args.csv))
     s = repertoire.summary()
     print(
         f"{repertoire.robot} repertoire: {s['count']} primitives, mean quality "
@@ -215,6 +208,40 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
         f"(seed {settings.seed}) -> {out}"
     )
     return 0
+
+
+def _run(args, settings, config, given: dict, checkpoint: Path) -> tuple[Repertoire, float]:
+    """Run MAP-Elites (resuming from ``checkpoint``); the repertoire and the seconds taken."""
+    from offline_evolution.repertoire.map_elites import CHECKPOINT_KIND, generate_repertoire
+    from offline_evolution.repertoire.settings import SettingError, blame
+
+    if args.restart:
+        restart_from_scratch(checkpoint, CHECKPOINT_KIND, "MAP-Elites checkpoint")
+    start = time.perf_counter()
+    with running("batch", "iteration") as stop:
+        try:
+            repertoire = generate_repertoire(
+                settings,
+                checkpoint=checkpoint,
+                checkpoint_every=args.checkpoint_every,
+                progress=_ProgressPrinter(args.quiet),
+                should_stop=stop,
+                workers=args.workers or None,
+                keep_checkpoint=True,
+            )
+        except SettingError as e:
+            raise blame(e, config, given) from None
+    elapsed = time.perf_counter() - start
+    out = args.out
+    if len(repertoire) == 0:
+        # A repertoire without primitives could drive nothing (and would not load).
+        checkpoint.unlink(missing_ok=True)
+        raise CliError(
+            f"no primitive was kept after {repertoire.algorithm['evaluations']:,} evaluations "
+            "(each one left the archive's range or was discarded); nothing written to "
+            f"{out}; try a larger budget or another --metric"
+        )
+    return repertoire, elapsed
 
 
 def _write(repertoire: Repertoire, out: Path, plot: str | None, csv: str | None) -> None:
@@ -234,7 +261,7 @@ def cmd_export_csv(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path(args.repertoire).with_suffix(".csv")
     out_option = "--out" if args.out else "the default --out"
     check_distinct({"REPERTOIRE": args.repertoire, out_option: out})
-    check_writable(out)
+    check_output_file(str(out), out_option)
     repertoire.to_csv(out)
     print(f"{len(repertoire)} primitives -> {out}")
     return 0

@@ -11,10 +11,10 @@ import numpy as np
 
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.cli_support import check_output_file
-from evorbc_ros.config import build_settings, config_dir
+from evorbc_ros.config import config_dir
 from evorbc_ros.defaults import default_repertoire
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.commands.common import CliError, count
+from offline_evolution.commands.common import CliError, at_least, count
 from sim_bridge.robots.hexapod import check_simulation, simulation_mismatch
 
 #: How a user lets another repertoire fingerprint or sensor layout through.
@@ -56,7 +56,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--seed", type=count, default=0, metavar="N", help="seed of random starts")
     p.add_argument(
         "--episodes",
-        type=count,
+        type=at_least(1),
         default=1,
         metavar="N",
         help="with --start random: N random starts per maze, reported per maze as how "
@@ -129,10 +129,12 @@ def check_design(
 def cmd_replay(args: argparse.Namespace) -> int:
     """Replay and report; optionally draw trajectories and the selection heatmap."""
     from offline_evolution.maze_task.replay import replay, summarise_outcomes
-    from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+    from offline_evolution.maze_task.task import CONTROL_PERIOD, MazeTaskSettings, make_task
+    from offline_evolution.memory import check_replay_memory
+    from sim_bridge.robots.base import control_steps
 
     arb_path = Path(args.arbitrator)
-    if args.episodes < 1 or (args.episodes > 1 and args.start != "random"):
+    if args.episodes > 1 and args.start != "random":
         raise CliError("--episodes N needs N >= 1, and N > 1 needs --start random")
     for path, option in ((args.plot, "--plot"), (args.heatmap, "--heatmap")):
         if path:
@@ -151,12 +153,21 @@ def cmd_replay(args: argparse.Namespace) -> int:
     if args.task:
         settings = MazeTaskSettings.load(args.task)
     elif recorded:
-        settings = build_settings(MazeTaskSettings, recorded, f"{arb_path}: evolution.task")
+        settings = MazeTaskSettings.from_dict(recorded, f"{arb_path}: evolution.task")
     else:
         family = "hexapod" if arb.robot == "hexapod" else "4ws"
         settings = MazeTaskSettings.load(config_dir() / "tasks" / f"maze-{family}.yaml")
     if args.maze != "all":
         settings = MazeTaskSettings((args.maze,), settings.episode_time, 1, settings.sensors)
+    where = args.task or (f"{arb_path}: evolution.task" if recorded else "the default task")
+    per_maze = args.episodes * settings.samples_per_maze if args.start == "random" else 1
+    check_replay_memory(
+        len(settings.mazes) * per_maze,
+        control_steps(settings.episode_time, CONTROL_PERIOD),
+        len(arb.network.output_keys),
+        arb.robot,
+        f"episode_time {settings.episode_time} s in {where}",
+    )
     task = make_task(settings, arb.robot)
     try:
         check_design(task.describe(), arb, arb_path, repertoire, rep_path)
@@ -174,6 +185,14 @@ def cmd_replay(args: argparse.Namespace) -> int:
         outcomes, result = replay(arb, task, starts, repertoire)
     finally:
         task.close()
+    for o in outcomes:
+        if o.stopped_cycles:
+            print(
+                f"evorbc-evolve: warning: {o.maze}: the network's outputs were not finite in "
+                f"{o.stopped_cycles} of {round(o.time / task.dt)} cycles; the robot stood still "
+                "in those (no primitive)",
+                file=sys.stderr,
+            )
     mean = float(np.mean([o.fitness for o in outcomes]))
     reached = sum(o.reached for o in outcomes)
     summary = summarise_outcomes(outcomes)

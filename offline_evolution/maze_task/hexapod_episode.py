@@ -6,8 +6,14 @@ the laser and radar nodes' own code (:class:`~evorbc_ros.laser.LaserToRangefinde
 (:class:`~evorbc_ros.network.CompiledNetwork`), pick the primitive (EvoRBC: mapping and
 nearest-primitive lookup; standard NEAT: the outputs are the 37 genes), and run the
 physics for one period with the joint targets of eq. 10 at every physics step (time since
-the episode began). The episode ends at the target, when the body has fallen over, or at
+the gait began). The episode ends at the target, when the body has fallen over, or at
 the time limit.
+
+A cycle whose network outputs are not finite runs no primitive, as onboard (the
+arbitrator's empty message, :mod:`evorbc_ros.hexapod_executor`): every joint holds the
+target being tracked, that is the last primitive's target at the cycle's first step, or
+the joints' start positions before any primitive. The gait clock starts with the first
+primitive, as the executor's does.
 
 The ROS graph computes the same numbers from the same messages, so a lockstep run
 reproduces an episode cycle by cycle.
@@ -22,9 +28,9 @@ import numpy as np
 
 from evorbc_ros.goal import GoalInputs, yaw_from_quaternion
 from evorbc_ros.laser import LaserToRangefinders
-from evorbc_ros.mapping import MappingFunction, PrimitiveLookup
+from evorbc_ros.mapping import NO_PRIMITIVE, MappingFunction, PrimitiveLookup, choose_primitive
 from evorbc_ros.network import NetworkSpec
-from evorbc_ros.robots.hexapod import GaitTable, HexapodGeometry
+from evorbc_ros.robots.hexapod import GaitTable, HexapodGeometry, gait_step_times
 from evorbc_ros.sensors import SensorLayout
 from sim_bridge.hexapod.maze_world import FALLEN_TILT
 from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings
@@ -70,12 +76,18 @@ class _Chooser:
             self.lookup = PrimitiveLookup.build(controller.behaviour, self.mapping.domain())
         self.geometry = geometry
 
-    def choose(self, out: np.ndarray) -> tuple[int, GaitTable, np.ndarray]:
-        """``(primitive index or -1, gait table, row)`` for one activation."""
+    def choose(self, out: np.ndarray) -> tuple[int, GaitTable | None, np.ndarray]:
+        """``(primitive index or -1, gait table, row)`` for one activation.
+
+        No table (None) when the outputs are not finite: no primitive runs this cycle.
+        """
         if self.kind == "evorbc":
-            x, y = self.mapping.point(out[0], out[1])
-            index = self.lookup.nearest(x, y)
+            index = choose_primitive(self.mapping, self.lookup, out[0], out[1])[0]
+            if index == NO_PRIMITIVE:
+                return index, None, np.array([0])
             return index, self.table, np.array([index])
+        if not np.all(np.isfinite(out)):
+            return NO_PRIMITIVE, None, np.array([0])
         genes = 2.0 * np.clip(out, 0.0, 1.0) - 1.0
         return -1, GaitTable(genes, self.geometry), np.array([0])
 
@@ -91,6 +103,7 @@ class EpisodeRunner:
         self.sims: dict[int, HexapodSim] = {}
         self.choosers: dict[str, _Chooser] = {}
         self.per_period = world.physics.steps(world.geometry.control_period)
+        self.dt = world.physics.dt  # s per physics step, the gait clock's tick
 
     def chooser(self, controller: HexapodController) -> _Chooser:
         """The chooser of ``controller`` (built once per controller key)."""
@@ -151,11 +164,25 @@ class EpisodeRunner:
         reached = fell = False
         poses, choices, outputs = [(x, y, heading)], [], []
         cycles = self.world.n_cycles
+        # The executor's state: the physics step its gait clock started at (the first
+        # primitive), the last gait run and the target held while none runs (rad).
+        gait_start, last, last_row = None, None, None
+        held = sim.joint_states()[0]  # before any primitive: where the joints stand
         for cycle in range(self.world.n_cycles):
             out = net.activate(self.inputs(sim, maze, base))
             index, table, row = chooser.choose(out)
-            times = sim.step_times(self.per_period)
-            targets = table.joint_targets(times, np.repeat(row, len(times)))
+            if table is not None:
+                if gait_start is None:
+                    gait_start = sim.steps_done
+                last, last_row = table, row
+                times = gait_step_times(sim.steps_done - gait_start, self.per_period, self.dt)
+                targets = table.joint_targets(times, np.repeat(row, len(times)))
+                held = None
+            else:
+                if held is None:  # the last gait's target at this cycle's first step
+                    now = gait_step_times(sim.steps_done - gait_start, 1, self.dt)
+                    held = last.joint_targets(now, last_row)[0]
+                targets = np.repeat(held[None, :], self.per_period, axis=0)
             tilt, _ = sim.run(targets, max_tilt=FALLEN_TILT)
             base = sim.base_pose()
             x, y, heading, _ = sim.pose(base)

@@ -7,6 +7,10 @@ runs the nearest primitive (grid lookup); a standard-NEAT controller's outputs a
 robot's genes. The episode ends when the robot's centre is within the target radius or
 after ``n_cycles`` cycles.
 
+A cycle whose network outputs are not finite (or, for EvoRBC, map to no finite point) runs
+no primitive, as onboard (:func:`evorbc_ros.mapping.choose_primitive`, the executor's empty
+message): zero wheel speed with the steering held at its last command.
+
 Episodes are independent, so results do not depend on the number of threads.
 """
 
@@ -24,6 +28,8 @@ from sim_bridge.geometry import grid_candidates
 from sim_bridge.sensors import read_sensors
 
 map_point = nb.njit(cache=True)(onboard_mapping.map_point)
+clamped_cell = nb.njit(cache=True)(onboard_mapping.clamped_cell)
+NO_PRIMITIVE = onboard_mapping.NO_PRIMITIVE
 
 #: Controller modes.
 EVORBC, STANDARD = 0, 1
@@ -33,8 +39,8 @@ EVORBC, STANDARD = 0, 1
 def _lookup(x, y, origin, cell, table):
     """Compiled :meth:`evorbc_ros.mapping.PrimitiveLookup.nearest`."""
     nx, ny = table.shape
-    i = min(max(math.floor((x - origin[0]) / cell[0]), 0), nx - 1)
-    j = min(max(math.floor((y - origin[1]) / cell[1]), 0), ny - 1)
+    i = clamped_cell((x - origin[0]) / cell[0], nx)
+    j = clamped_cell((y - origin[1]) / cell[1], ny)
     return table[i, j]
 
 
@@ -117,7 +123,9 @@ def run_episodes(
         inputs = np.empty(sensors.n_inputs)
         values = np.empty(max_slots)
         out = np.empty(n_outputs)
-        command = np.empty(5)
+        # (speed m/s, 4 steering angles rad); a stop keeps the last angles, as the executor
+        # does, which start at 0.
+        command = np.zeros(5)
         before = np.empty(STATE_SIZE)
         initial_distance[e] = math.hypot(start[e, 0] - tx, start[e, 1] - ty)
         dist = initial_distance[e]
@@ -129,18 +137,26 @@ def run_episodes(
             read_sensors(x, y, h, tx, ty, sensors, boxes, cand, inputs)
             activate(g, inputs, values, out, net)
             choice = -1
-            if mode == EVORBC:
+            finite = True
+            for k in range(n_outputs):
+                finite = finite and math.isfinite(out[k])
+            if mode == EVORBC and finite:
                 px, py = map_point(map_kind, map_params, out[0], out[1])
-                choice = _lookup(px, py, lookup_origin, lookup_cell, lookup_table)
-                for c in range(5):
-                    command[c] = primitive_commands[choice, c]
-            else:
+                finite = math.isfinite(px) and math.isfinite(py)
+                if finite:
+                    choice = _lookup(px, py, lookup_origin, lookup_cell, lookup_table)
+                    for c in range(5):
+                        command[c] = primitive_commands[choice, c]
+            elif finite:
                 for c in range(5):
                     acc = 0.0
                     for k in range(n_outputs):
                         gene = 2.0 * min(max(out[k], 0.0), 1.0) - 1.0
                         acc += gene * gene_matrix[k, c]
                     command[c] = acc * command_scale[c]
+            if not finite:
+                choice = NO_PRIMITIVE
+                command[0] = 0.0  # no primitive: stop, steering held
             if record:
                 trace_pose[e, t, 0] = x
                 trace_pose[e, t, 1] = y

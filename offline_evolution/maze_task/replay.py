@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from evorbc_ros.arbitrator import ArbitratorFile
+from evorbc_ros.mapping import NO_PRIMITIVE
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.maze_task.task import EpisodeResult, MazeTask
 
@@ -23,6 +24,8 @@ class MazeOutcome:
     start: tuple[float, float, float]  # x m, y m, heading rad
     switches_per_cycle: float  # how often the chosen primitive changed (EvoRBC)
     fell: bool = False  # the robot fell over (legged robots), which ended the episode
+    # Cycles with no primitive (the network's outputs were not finite): the robot stood.
+    stopped_cycles: int = 0
 
     def as_dict(self) -> dict:
         """Plain-data form (``replay --json``)."""
@@ -35,6 +38,7 @@ class MazeOutcome:
             "start": list(self.start),
             "switches_per_cycle": self.switches_per_cycle,
             "fell": self.fell,
+            "stopped_cycles": self.stopped_cycles,
         }
 
 
@@ -52,6 +56,10 @@ def replay(
         n = int(result.cycles[e])
         choice = result.choice[e, :n]
         switches = float(np.mean(choice[1:] != choice[:-1])) if n > 1 else 0.0
+        if arbitrator.kind == "evorbc":
+            stopped = int(np.sum(choice == NO_PRIMITIVE))
+        else:  # a standard controller has no primitive index: its outputs tell
+            stopped = int(np.sum(~np.all(np.isfinite(result.outputs[e, :n]), axis=1)))
         outcomes.append(
             MazeOutcome(
                 maze=task.mazes[int(row[0])].name,
@@ -62,6 +70,7 @@ def replay(
                 start=(float(row[1]), float(row[2]), float(row[3])),
                 switches_per_cycle=switches if arbitrator.kind == "evorbc" else 0.0,
                 fell=bool(result.fell[e]) if result.fell is not None else False,
+                stopped_cycles=stopped,
             )
         )
     return outcomes, result

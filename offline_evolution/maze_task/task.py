@@ -53,28 +53,45 @@ class MazeTaskSettings:
         """Settings from a task file (``config/tasks/*.yaml``).
 
         Raises:
-            ConfigError: naming the file and the key, for any bad setting; episode_time
-                must be a whole number of the 0.1 s control cycles that every robot
-                family here uses (paper Sec. III-C).
+            ConfigError: naming the file and the key, for any bad setting (see
+                :meth:`from_dict`).
         """
-        settings = build_settings(cls, load_yaml_mapping(path), str(path))
+        return cls.from_dict(load_yaml_mapping(path), str(path))
+
+    @classmethod
+    def from_dict(cls, values: dict, source: str) -> MazeTaskSettings:
+        """Settings from a mapping: a task file's, or the one an arbitrator file records.
+
+        Raises:
+            ConfigError: naming ``source`` and the key, for any bad setting; episode_time
+                must be a whole number of the 0.1 s control cycles that every robot
+                family here uses (paper Sec. III-C), and every maze and the sensor
+                layout must load.
+        """
+        if not isinstance(values, dict):
+            raise ConfigError(f"{source}: expected a mapping of task settings")
+        settings = build_settings(cls, values, source)
         try:
             control_steps(settings.episode_time, CONTROL_PERIOD)
         except ValueError as e:
-            raise ConfigError(f"{path}: episode_time {e}") from None
+            raise ConfigError(f"{source}: episode_time {e}") from None
         if not settings.mazes:
-            raise ConfigError(f"{path}: mazes must name at least one maze")
-        # The files the task refers to, checked here so that an error names this file.
+            raise ConfigError(f"{source}: mazes must name at least one maze")
+        # The files the task refers to, checked here so that an error names this source.
         for name in settings.mazes:
             try:
                 load_named_maze(name)
             except ConfigError as e:
-                raise ConfigError(f"{path}: mazes: {e}") from None
-        if not (config_dir() / settings.sensors).is_file():
+                raise ConfigError(f"{source}: mazes: {e}") from None
+        layout = config_dir() / settings.sensors
+        if not layout.is_file():
             raise ConfigError(
-                f"{path}: sensors: no such file {config_dir() / settings.sensors} "
-                "(the path is relative to config/)"
+                f"{source}: sensors: no such file {layout} (the path is relative to config/)"
             )
+        try:
+            SensorLayout.load(layout)
+        except ConfigError as e:
+            raise ConfigError(f"{source}: sensors: {e}") from None
         return settings
 
     def as_dict(self) -> dict:

@@ -82,7 +82,10 @@ class PaperMutationEmitter(EmitterBase):
 
     def set_state(self, state: dict) -> None:
         """Restore what :meth:`get_state` returned."""
-        self.rng.bit_generator.state = state["rng"]
+        try:
+            self.rng.bit_generator.state = state["rng"]
+        except (OverflowError, TypeError, ValueError) as e:  # numbers no generator holds
+            raise ValueError(f"emitter.rng is not a random generator's state ({e})") from None
         self.initial_remaining = int(state["initial_remaining"])
 
 

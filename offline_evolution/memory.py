@@ -1,0 +1,154 @@
+"""The memory a run needs, estimated from its settings and refused up front if too much.
+
+Settings that would exhaust memory (``samples_per_maze: 100000``, a tiny ``bin_size``, a
+day-long ``episode_time`` replayed with its traces) used to end in ``std::bad_alloc`` or a
+MemoryError after minutes of work. Each command estimates its largest allocation from its
+settings and refuses, in one line that names the setting and what to lower, a run that
+would need more than :data:`SHARE` of the machine's physical memory (``os.sysconf``).
+
+The constants are measured, rounded up (bench notes in docs/performance.md): the 4WS
+kernel keeps about 350 bytes per episode of a generation, a recorded replay about 100
+bytes per control cycle, a repertoire about 400 bytes per primitive of a batch and
+``(parameters + 8) x 8`` bytes per archive cell.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+from evorbc_ros.config import ConfigError
+
+#: The share of the machine's physical memory a run may plan to use.
+SHARE = 0.5
+GIB = 1 << 30
+#: Bytes per episode of one evaluation call (state, start, results, index arrays). The
+#: hexapod's episodes also carry their network and results between processes.
+EPISODE_BYTES = {"4ws": 400, "hexapod": 16_000}
+#: Bytes per recorded control cycle of a replay: pose (3), choice (1), outputs; x 1.3
+#: for the temporaries of the report.
+CYCLE_BYTES_PER_VALUE = 8 * 1.3
+#: Bytes per primitive of a MAP-Elites batch (genes, outcome, copies for the archive).
+EVALUATION_BYTES = 400
+#: Bytes a run needs anyway (Python, numpy, numba, pyribs).
+BASE_BYTES = 400 << 20
+
+
+def machine_memory() -> int:
+    """Physical memory of this machine (bytes), from ``os.sysconf``."""
+    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+
+
+def _gib(n: float) -> str:
+    if n >= 1e18 * GIB:  # settings far beyond any machine (a count of 10**30)
+        return "more than 10^18 GiB"
+    return f"{n / GIB:.1f} GiB" if n >= GIB / 10 else f"{n / (1 << 20):.0f} MiB"
+
+
+def check_memory(need: float, what: str, advice: str) -> None:
+    """Refuse a run that would need more than :data:`SHARE` of the machine's memory.
+
+    Args:
+        need: the estimate, bytes.
+        what: where the need comes from, with the setting's file and key.
+        advice: what to lower.
+
+    Raises:
+        ConfigError: one line with the estimate, the limit and the advice.
+    """
+    ram = machine_memory()
+    limit = SHARE * ram
+    if need > limit:
+        raise ConfigError(
+            f"{what} needs about {_gib(need)} of memory, more than this machine allows a run "
+            f"({_gib(limit)}, half of its {_gib(ram)}); {advice}"
+        )
+
+
+def family(robot: str) -> str:
+    """``hexapod`` or ``4ws``: the robot family whose constants apply."""
+    return "hexapod" if robot == "hexapod" else "4ws"
+
+
+def check_evolution_memory(
+    task, pop_size: int, robot: str, source: str, post_candidates: int, post_samples: int
+) -> None:
+    """Refuse an evolution whose generation (or post-evaluation) cannot fit in memory.
+
+    Args:
+        task: the :class:`~offline_evolution.maze_task.task.MazeTaskSettings`.
+        pop_size: NEAT's population.
+        source: the task settings' file, for the message.
+        post_candidates: genomes the post-evaluation re-runs (at most 3 x hall_of_fame).
+        post_samples: its random starts per maze (plus the nominal one).
+    """
+    mazes = len(task.mazes)
+    per_episode = EPISODE_BYTES[family(robot)]
+    generation = pop_size * mazes * task.samples_per_maze
+    post = post_candidates * mazes * (post_samples + 1)
+    check_memory(
+        BASE_BYTES + per_episode * generation,
+        f"{source}: samples_per_maze {task.samples_per_maze} ({generation:,} episodes a "
+        f"generation: {pop_size} genomes x {mazes} mazes x {task.samples_per_maze} starts)",
+        "lower samples_per_maze, the number of mazes or pop_size",
+    )
+    check_memory(
+        BASE_BYTES + per_episode * post,
+        f"the post-evaluation ({post:,} episodes: {post_candidates} genomes x {mazes} mazes "
+        f"x {post_samples + 1} starts)",
+        "lower post_samples or hall_of_fame",
+    )
+
+
+def replay_bytes(episodes: int, n_cycles: int, n_outputs: int, robot: str) -> float:
+    """Bytes of a recorded replay of ``episodes`` episodes of ``n_cycles`` cycles."""
+    trace = (n_cycles + 1) * (4 + n_outputs) * CYCLE_BYTES_PER_VALUE
+    return BASE_BYTES + episodes * (EPISODE_BYTES[family(robot)] + trace)
+
+
+def check_replay_memory(
+    episodes: int, n_cycles: int, n_outputs: int, robot: str, source: str
+) -> None:
+    """Refuse a replay whose recorded traces cannot fit in memory.
+
+    Args:
+        source: where ``episode_time`` came from (the task file or the arbitrator's record).
+    """
+    check_memory(
+        replay_bytes(episodes, n_cycles, n_outputs, robot),
+        f"replaying {episodes:,} episodes of {n_cycles:,} control cycles ({source})",
+        "lower episode_time, --episodes or the number of mazes",
+    )
+
+
+def repertoire_cells(robot: str, eval_time: float, bin_size: float) -> int:
+    """Cells of a repertoire run's archive (grid or CVT: as many), from its settings."""
+    from evorbc_ros.robots.four_ws import FourWSGeometry
+    from sim_bridge.robots.hexapod import SPEED_BOUND
+
+    speed = SPEED_BOUND if robot == "hexapod" else FourWSGeometry().max_speed
+    half = max(0, math.ceil(speed * eval_time / bin_size - 0.5))
+    return (2 * half + 1) ** 2
+
+
+def check_repertoire_memory(settings, n_parameters: int, name) -> None:
+    """Refuse a MAP-Elites run whose archive or batch cannot fit in memory.
+
+    Args:
+        settings: the :class:`~offline_evolution.repertoire.settings.MapElitesSettings`.
+        name: ``name(key)`` says where a setting came from (``--bin-size`` or
+            ``FILE: bin_size``), for the message.
+    """
+    cells = repertoire_cells(settings.robot, settings.eval_time, settings.bin_size)
+    check_memory(
+        BASE_BYTES + cells * (n_parameters + 8) * 8,
+        f"{name('bin_size')} {settings.bin_size} ({cells:,} archive cells for "
+        f"eval_time {settings.eval_time} s)",
+        "raise bin_size or lower eval_time",
+    )
+    check_memory(
+        BASE_BYTES + settings.batch_size * (EVALUATION_BYTES + 32 * n_parameters),
+        f"{name('batch_size')} {settings.batch_size} (primitives evaluated at once; the "
+        "initial batch runs in pieces of this size)",
+        "lower batch_size",
+    )
