@@ -2,6 +2,8 @@
 line that reaches /rosout, the executor stays silent until the arbitrator speaks, primitives
 for another robot are refused, and goals come from latched and volatile publishers alike."""
 
+import os
+
 import pytest
 from geometry_msgs.msg import PointStamped, PoseStamped
 from nav_msgs.msg import Odometry
@@ -185,3 +187,11 @@ def test_rviz_goal_poses_are_taken_through_a_remapping(monkeypatch):
         odom_pub.publish(odom)
         assert ros.spin_until(lambda: out)
         assert list(out[0].data) == [0, 1, 0, 0]  # the goal is left: the 90 deg sector
+
+
+def test_a_record_file_that_is_not_a_regular_file_is_refused_without_blocking(ros, tmp_path):
+    fifo = tmp_path / "choices.fifo"
+    os.mkfifo(fifo)  # opening it for writing would block until a reader came
+    with pytest.raises(StartupError) as info:
+        ros.make(ArbitratorNode, record_file=str(fifo))
+    assert str(info.value) == f"parameter record_file: {fifo} is not a regular file"

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 
 import numpy as np
@@ -104,6 +105,9 @@ class ArbitratorNode(Node):
                 "",
                 "append every choice here as JSON lines (m1, m2, x, y, primitive)",
             )
+            # An existing non-regular file (a FIFO) would block open() until a reader comes.
+            if record and os.path.exists(record) and not os.path.isfile(record):
+                raise StartupError(f"parameter record_file: {record} is not a regular file")
             try:
                 self.record = open(record, "a", buffering=1) if record else None  # noqa: SIM115
             except OSError as e:
