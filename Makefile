@@ -28,13 +28,15 @@ demo-hexapod: $(STAMP)
 		--result $(OUT)/hexapod-run.json
 	@echo "demo-hexapod: open $(OUT)/hexapod-run.png"
 
-# A MAP-Elites repertoire for the 4ws-5 robot at the paper's full budget (about 5 s).
+# A MAP-Elites repertoire for the 4ws-5 robot at the paper's full budget (1.01M evaluations;
+# README, "How long things take", has measured times).
 demo-repertoire: $(STAMP)
 	$(VENV)/bin/evorbc-evolve repertoire --robot 4ws-5 --seed 1 \
 		--out $(OUT)/4ws-5.repertoire.json --plot $(OUT)/4ws-5.repertoire.png \
 		--csv $(OUT)/4ws-5.repertoire.csv
 
-# A whole EvoRBC run: repertoire, then 1000 generations of NEAT (about 8-10 min on 2 cores).
+# A whole EvoRBC run: repertoire, then 1000 generations of NEAT, then a replay (9 min of
+# evolution on 2 cores with the machine to itself; README, "How long things take").
 demo-evolve: demo-repertoire
 	$(VENV)/bin/evorbc-evolve arbitrator --repertoire $(OUT)/4ws-5.repertoire.json --seed 1 \
 		--out $(OUT)/4ws-5.arbitrator.json

@@ -10,7 +10,7 @@ everything is forgotten and the robot stops until a new primitive arrives.
 An empty primitive message is the arbitrator's "no primitive" (its network's outputs were
 not finite): the robot stops at once, as for stale inputs, until the next primitive. The
 offline episodes stop the same way for such a cycle, so a lockstep run still equals the
-offline replay cycle by cycle (DESIGN.md section 7).
+offline replay cycle by cycle (docs/design.md section 7).
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ the times are bit-identical to the offline simulation's. When the primitive or a
 input is stale, or the arbitrator chose no primitive (an empty message: its network's
 outputs were not finite), the command holds the last targets: the legs stop where they are
 and the robot stands still. Before any target was sent there is none to hold; the node then
-sends an empty trajectory, ROS's "stop and hold where you are" (DESIGN.md section 7).
+sends an empty trajectory, ROS's "stop and hold where you are" (docs/design.md section 7).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Mapping functions and primitive choice (paper eq. 4, 7-9; DESIGN.md section 7).
+"""Mapping functions and primitive choice (paper eq. 4, 7-9; docs/design.md section 7).
 
 The arbitrator outputs ``m = (m1, m2)`` in [0, 1]^2. A mapping function turns them into a
 point of the behaviour space (m, start frame: x forward, y left) and the primitive whose
@@ -17,7 +17,7 @@ gives, built by pruning primitives that cannot be nearest to a block of cells
 (:func:`nearest_on_grid`), so it takes seconds, not minutes, for 200,000 primitives.
 
 A network output that is not finite (NaN or infinite), or a point that is not, chooses
-no primitive (:data:`NO_PRIMITIVE`): the robot stops for that cycle (DESIGN.md section 7).
+no primitive (:data:`NO_PRIMITIVE`): the robot stops for that cycle (docs/design.md section 7).
 """
 
 from __future__ import annotations
@@ -150,7 +150,7 @@ def choose_primitive(
     """``(primitive index, x, y)`` for network outputs ``(m1, m2)``.
 
     Non-finite outputs, or a point that overflows to infinity, choose no primitive:
-    ``(NO_PRIMITIVE, nan, nan)``. The robot then stops for the cycle (DESIGN.md section 7).
+    ``(NO_PRIMITIVE, nan, nan)``. The robot then stops for the cycle (docs/design.md section 7).
     """
     if not (math.isfinite(m1) and math.isfinite(m2)):
         return NO_PRIMITIVE, math.nan, math.nan

@@ -1,7 +1,7 @@
 """What an off-centre scanner saw, as geometry in the body frame (docs/laser.md).
 
 A rangefinder of the sensor layout is a set of rays from the body centre that start at the
-mount ring (``mount_radius``), as the offline simulator casts them (DESIGN.md section 5).
+mount ring (``mount_radius``), as the offline simulator casts them (docs/design.md section 5).
 When the scanner sits elsewhere on the body, no beam runs along such a ray, so the laser
 node rebuilds the scanner's view and casts the rays into it:
 

@@ -1,4 +1,4 @@
-"""Sensor layouts and how raw measurements become arbitrator inputs (DESIGN.md section 5).
+"""Sensor layouts and how raw measurements become arbitrator inputs (docs/design.md section 5).
 
 Rangefinders: each is mounted at ``mount_radius`` from the body centre, pointing along its
 angle; it reads the nearest wall within its field of view as ``(range - d) / range``

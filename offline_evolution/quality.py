@@ -1,4 +1,4 @@
-"""Quality (fitness) metrics of a locomotion primitive (paper Sec. III-A, DESIGN.md section 3).
+"""Quality (fitness) metrics of a locomotion primitive (paper Sec. III-A, docs/design.md section 3).
 
 Every metric takes the outcome of primitives executed for T seconds from rest at the
 origin facing +x, as arrays: final position ``x, y`` (m, start frame), final heading

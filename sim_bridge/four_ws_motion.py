@@ -1,4 +1,4 @@
-"""The 4WS motion model (DESIGN.md section 2), compiled with numba and batched.
+"""The 4WS motion model (docs/design.md section 2), compiled with numba and batched.
 
 This is the one motion model used everywhere: repertoire generation, the maze task and the
 simulation bridge all call :func:`step_robot`. Everything here works on plain floats and
@@ -220,7 +220,7 @@ def step_robot(state, i, command, lim, boxes, candidates):
 
     Rate limits apply first; the body then moves with the limited speed and wheel angles.
     If the footprint would overlap a wall after the step, the position stays where it was
-    and the heading change is kept (DESIGN.md section 2).
+    and the heading change is kept (docs/design.md section 2).
 
     Args:
         state: ``(n, STATE_SIZE)`` robot states, updated in place.
@@ -264,7 +264,7 @@ def run_primitives(commands, n_steps, lim):
     """Execute primitives from rest at the origin facing +x, in free space.
 
     Each row of ``commands`` is held constant for ``n_steps`` control steps; rate limits
-    apply throughout (DESIGN.md section 2). Robots are independent, so the result does not
+    apply throughout (docs/design.md section 2). Robots are independent, so the result does not
     depend on the number of threads.
 
     Args:

@@ -4,7 +4,7 @@ One description serves both ways of bringing the graph up: ``evorbc-sim``
 (:mod:`sim_bridge.bringup`, the nodes as plain processes) and ``ros2 launch evorbc_ros
 sim.launch.py`` (a thin wrapper over :func:`graph_from_arguments`). It imports neither
 rclpy nor ``launch``, so the launch logic is tested wherever the project's tests run
-(DESIGN.md section 10).
+(docs/design.md section 10).
 
 Both fill in the same defaults: the robot's shipped controller when no arbitrator is given
 (none for a 4WS type other than 4ws-5: the arbitrator node then refuses to start and says

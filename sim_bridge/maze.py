@@ -1,4 +1,4 @@
-"""Mazes for the navigation task (paper Sec. IV-B, DESIGN.md section 4).
+"""Mazes for the navigation task (paper Sec. IV-B, docs/design.md section 4).
 
 A maze file is YAML in ``config/mazes/``::
 

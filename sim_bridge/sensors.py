@@ -1,4 +1,4 @@
-"""Simulated sensors of a robot in a maze, compiled (DESIGN.md section 5).
+"""Simulated sensors of a robot in a maze, compiled (docs/design.md section 5).
 
 The reading formulas are the onboard ones from :mod:`evorbc_ros.sensors`, compiled as they
 are, so the simulator and the ROS sensor nodes cannot drift apart. Rays are cast against

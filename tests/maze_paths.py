@@ -24,7 +24,7 @@ from scipy.sparse.csgraph import dijkstra
 from sim_bridge.geometry import box_distances
 from sim_bridge.maze import Maze
 
-ROBOT_RADIUS = 0.05  # m, collision footprint of the 4WS robot (DESIGN.md section 2)
+ROBOT_RADIUS = 0.05  # m, collision footprint of the 4WS robot (docs/design.md section 2)
 MARGIN = 0.06  # m, clearance a path must keep from every wall surface
 SNAP = 0.02  # m, a start may step this far to the nearest free cell (clearance 0.05 -> 0.06)
 FOLLOW = 0.08  # m, distance a wall follower keeps from the wall it follows

@@ -1,4 +1,4 @@
-"""Plain-Python reference of the 4WS motion model (DESIGN.md section 2).
+"""Plain-Python reference of the 4WS motion model (docs/design.md section 2).
 
 Written from the specification alone, for clarity rather than speed, to cross-check the
 compiled model in ``sim_bridge.four_ws_motion``. Body frame: x forward, y left, angles

@@ -1,4 +1,4 @@
-"""The 4WS motion model against hand-computed cases (DESIGN.md section 2)."""
+"""The 4WS motion model against hand-computed cases (docs/design.md section 2)."""
 
 import math
 

@@ -1,6 +1,6 @@
 """Cross-check the compiled 4WS motion model against the plain-Python reference.
 
-The reference (``tests/reference_four_ws.py``) is written from DESIGN.md section 2 only. Inputs
+The reference (``tests/reference_four_ws.py``) is written from docs/design.md section 2 only. Inputs
 whose evaluation comes within ``MARGIN`` of a decision threshold (parallel tolerance, slip
 limit, wheel rectangle, wall clearance, exactly parallel axles) are left out, because there
 rounding alone may decide; everything else must agree to ``TOL``.
@@ -284,7 +284,7 @@ def test_straight_into_wall_ahead():
 def test_rounding_level_side_difference_counts_as_parallel():
     """Not a reference comparison: documents the project's reading of "equal angles".
 
-    DESIGN.md says two axle lines with *equal* angles have no intersection. Taken literally,
+    docs/design.md says two axle lines with *equal* angles have no intersection. Taken literally,
     a side whose wheels differ by one rounding error would put the ICR ~1e14 m away and change
     the outcome completely; the project treats differences up to ~1e-9 rad as equal. Here a
     side differing by 1e-12 rad must behave exactly like the exactly parallel side.

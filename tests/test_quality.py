@@ -1,4 +1,4 @@
-"""Quality metrics on analytic arcs and lines, forward and backward (DESIGN.md section 3)."""
+"""Quality metrics on analytic arcs and lines, forward and backward (docs/design.md section 3)."""
 
 import math
 

@@ -1,4 +1,4 @@
-"""Installed with pip, the package registers itself in the ament index (DESIGN.md section 10).
+"""Installed with pip, the package registers itself in the ament index (docs/design.md section 10).
 
 ``ros2 run evorbc_ros <node>`` looks up ``share/ament_index/resource_index/packages/
 evorbc_ros`` under ``AMENT_PREFIX_PATH`` and runs ``<prefix>/lib/evorbc_ros/<node>``. This

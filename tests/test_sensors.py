@@ -1,4 +1,4 @@
-"""The 4WS robot's sensors (DESIGN.md section 5) against hand-computed readings.
+"""The 4WS robot's sensors (docs/design.md section 5) against hand-computed readings.
 
 The room used below: walls on the segments of the rectangle (0, 0) - (2, 1), 0.01 m thick,
 so the inner faces are x = 0.005, x = 1.995, y = 0.005 and y = 0.995.

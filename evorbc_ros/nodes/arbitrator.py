@@ -191,7 +191,7 @@ def load_controller(
 
     An empty ``arbitrator`` means the one shipped for ``robot`` (4ws-5 if ``robot`` is
     empty). A controller for another robot than ``robot`` could never drive it: its
-    primitives have other parameters (DESIGN.md section 9), so it is refused here, not
+    primitives have other parameters (docs/design.md section 9), so it is refused here, not
     discovered later as a robot that never moves.
 
     Raises:

@@ -1,6 +1,6 @@
 """Shared pieces of the evorbc ROS 2 nodes: QoS, vector messages, start-up and main().
 
-Conventions (DESIGN.md section 9): sensor streams from other stacks are subscribed with
+Conventions (docs/design.md section 9): sensor streams from other stacks are subscribed with
 ``qos_profile_sensor_data``; everything evorbc publishes is reliable (a best-effort
 subscriber still receives it); the goal is latched (transient local) so a node that starts
 late still gets it.

@@ -28,7 +28,7 @@ WHEEL_NAMES = ("fl", "fr", "rl", "rr")
 
 @dataclass(frozen=True)
 class FourWSGeometry:
-    """Body geometry and actuator limits of the 4WS robot (DESIGN.md section 2).
+    """Body geometry and actuator limits of the 4WS robot (docs/design.md section 2).
 
     Defaults are the original simulator's values: a 0.10 x 0.10 m body whose wheels touch
     the ground at (+-0.025, +-0.025) m from the centre.

@@ -1,7 +1,7 @@
 """What every robot's locomotion primitive has in common: named, ranged parameters.
 
 A primitive is a vector of genes in [-1, 1]; gene ``k`` maps linearly onto the physical
-range of parameter ``k`` (DESIGN.md section 2).
+range of parameter ``k`` (docs/design.md section 2).
 """
 
 from __future__ import annotations

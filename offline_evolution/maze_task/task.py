@@ -1,6 +1,6 @@
 """The maze task: settings, controllers as arrays, episodes and eq. 5 fitness.
 
-A controller's fitness in one episode is (paper eq. 5, DESIGN.md section 4)::
+A controller's fitness in one episode is (paper eq. 5, docs/design.md section 4)::
 
     2 - t / T          if the target was reached after t seconds (T = episode_time)
     1 - d_f / d_i      otherwise (final over initial distance to the target)

@@ -2,7 +2,7 @@
 
 A robot says what its locomotion parameters are and how a batch of primitives behaves when
 executed for T seconds from rest; the search code (MAP-Elites, NEAT tasks) never needs to
-know which robot it drives (STYLE.md: adding a robot does not touch the search code).
+know which robot it drives: adding a robot does not touch the search code.
 """
 
 from __future__ import annotations
