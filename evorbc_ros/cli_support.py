@@ -1,5 +1,6 @@
-"""What the command-line programs (``evorbc-evolve``, ``evorbc-sim``) share.
+"""What the command-line programs (``evorbc-evolve``, ``evorbc-sim``, ``evorbc-study``) share.
 
+* Argument errors in one line and status 2 (:class:`OneLineParser`, :func:`integer_in`).
 * The last-resort report: whatever no check caught ends as one line and status 1, never a
   traceback (``EVORBC_DEBUG=1`` shows one).
 * Output paths checked before a run, so that a typo costs nothing rather than a whole run.
@@ -7,6 +8,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 from pathlib import Path
@@ -15,6 +17,39 @@ from evorbc_ros.config import ConfigError
 
 #: Set (to anything) to get the traceback of an internal error instead of one line.
 DEBUG_VARIABLE = "EVORBC_DEBUG"
+#: Exit status of a bad option (argparse's).
+EXIT_USAGE = 2
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (no usage block) and status 2.
+
+    Every bad option value ends the same way, whether the parser or a later check finds
+    it: ``evorbc-evolve arbitrator: error: argument --generations: expected an integer
+    >= 1, got '0' (see evorbc-evolve arbitrator --help)``.
+    """
+
+    def error(self, message: str):
+        """Print one line and exit with the usage status."""
+        text = " ".join(message.split())
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {text} (see {self.prog} --help)\n")
+
+
+def integer_in(low: int, high: int | None = None):
+    """Argparse type: an integer in ``[low, high]`` (no upper bound if ``high`` is None)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < low or (high is not None and value > high):
+            bounds = f"from {low} to {high}" if high is not None else f">= {low}"
+            raise argparse.ArgumentTypeError(f"expected an integer {bounds}, got {text!r}")
+        return value
+
+    parse.__name__ = f"integer >= {low}" if high is None else f"integer {low}-{high}"
+    return parse
 
 
 def report_unexpected(prog: str, error: Exception) -> int:

@@ -18,17 +18,12 @@ import sys
 from collections.abc import Sequence
 
 from evorbc_ros.arbitrator import ArbitratorError
-from evorbc_ros.cli_support import report_unexpected
+from evorbc_ros.cli_support import OneLineParser, report_unexpected
 from evorbc_ros.config import ConfigError
 from evorbc_ros.repertoire import RepertoireError
 from offline_evolution.checkpoint import CheckpointError
 from offline_evolution.commands import arbitrator, repertoire, replay
-from offline_evolution.commands.common import (
-    EXIT_ERROR,
-    EXIT_INTERRUPTED,
-    CliError,
-    OneLineParser,
-)
+from offline_evolution.commands.common import EXIT_ERROR, EXIT_INTERRUPTED, CliError
 
 
 def build_parser() -> argparse.ArgumentParser:

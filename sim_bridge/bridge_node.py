@@ -357,10 +357,11 @@ class SimBridgeNode(Node):
             executor.remove_node(self)
 
     def finish(self, interrupted: bool = False) -> dict:
-        """Write the result file and log the result (through the node while it can publish).
+        """Write the result file and log the result through the node.
 
-        After SIGINT rclpy has already shut the context down, so the node's logger could
-        no longer reach ``/rosout``; the caller logs the verdict once the node is gone.
+        A signal only asks the loops to end (docs/design.md section 9), so the context is
+        still up here and the verdict reaches ``/rosout``; if it is not (the context was
+        shut down by other means), the caller logs the verdict once the node is gone.
         """
         s = self.world.status()
         result = {

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorError
-from evorbc_ros.cli_support import check_output_file, report_unexpected
+from evorbc_ros.cli_support import OneLineParser, check_output_file, integer_in, report_unexpected
 from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, shipped_robots
 from evorbc_ros.nodes.common import StartupError
@@ -44,32 +44,9 @@ MAX_DOMAIN_ID = 232
 NODES = {n.name: n.module for n in sim_graph().nodes if n.package == "evorbc_ros"}
 
 
-class _Parser(argparse.ArgumentParser):
-    """Usage errors in one line (no usage block), status 2."""
-
-    def error(self, message: str):
-        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
-
-
-def _int_range(low: int, high: int | None = None):
-    """Argparse type: an integer in ``[low, high]`` (no upper bound if ``high`` is None)."""
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-        if value < low or (high is not None and value > high):
-            bounds = f"from {low} to {high}" if high is not None else f">= {low}"
-            raise argparse.ArgumentTypeError(f"expected an integer {bounds}, got {text!r}")
-        return value
-
-    return parse
-
-
 def parse_args(argv=None) -> argparse.Namespace:
     """Command-line options of ``evorbc-sim``."""
-    p = _Parser(
+    p = OneLineParser(
         prog="evorbc-sim",
         description="Run an evolved controller through the ROS 2 graph "
         "against the PyBullet simulation bridge, one maze episode.",
@@ -102,13 +79,13 @@ def parse_args(argv=None) -> argparse.Namespace:
         help="lockstep: deterministic and fast (default); realtime: 10 Hz wall clock",
     )
     p.add_argument("--start", default="nominal", help="nominal, random or 'x,y,heading_deg'")
-    p.add_argument("--seed", type=_int_range(0), default=0, help="seed of a random start")
+    p.add_argument("--seed", type=integer_in(0), default=0, help="seed of a random start")
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--plot", default="", help="trajectory picture (default: <maze>-run.png)")
     p.add_argument("--result", default="", help="also keep the result as JSON here")
     p.add_argument(
         "--domain-id",
-        type=_int_range(0, MAX_DOMAIN_ID),
+        type=integer_in(0, MAX_DOMAIN_ID),
         default=None,
         help=f"ROS_DOMAIN_ID for the graph, 0 to {MAX_DOMAIN_ID} (default: the environment's, "
         "else 0)",

@@ -12,8 +12,9 @@ import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+from evorbc_ros.cli_support import integer_in
+
 EXIT_ERROR = 1
-EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
 
 
@@ -25,34 +26,13 @@ class CliError(Exception):
         self.code = code
 
 
-class OneLineParser(argparse.ArgumentParser):
-    """An argument parser whose errors are one line (no usage block) and status 2.
-
-    Every bad option value ends the same way, whether the parser or a later check finds
-    it: ``evorbc-evolve arbitrator: error: argument --generations: expected an integer
-    >= 1, got '0'``; ``--help`` shows the usage.
-    """
-
-    def error(self, message: str):
-        """Print one line and exit with the usage status."""
-        text = " ".join(message.split())
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {text} (see {self.prog} --help)\n")
+#: ``integer >= low`` argument types (kept under this name for the subcommands).
+at_least = integer_in
 
 
-def at_least(low: int):
-    """Argparse type: an integer >= ``low``."""
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-        if value < low:
-            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {text!r}")
-        return value
-
-    parse.__name__ = f"integer >= {low}"
-    return parse
+def count(text: str) -> int:
+    """Argparse type: an integer >= 0."""
+    return integer_in(0)(text)
 
 
 def positive_float(text: str) -> float:
@@ -63,17 +43,6 @@ def positive_float(text: str) -> float:
         raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
     if not (value > 0 and math.isfinite(value)):
         raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
-    return value
-
-
-def count(text: str) -> int:
-    """Argparse type: an integer >= 0."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a non-negative integer, got {text!r}")
     return value
 
 

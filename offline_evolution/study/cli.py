@@ -21,7 +21,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from evorbc_ros.cli_support import report_unexpected
+from evorbc_ros.cli_support import OneLineParser, integer_in, report_unexpected
 from evorbc_ros.config import ConfigError
 
 EXIT_ERROR = 1
@@ -30,16 +30,6 @@ EXIT_INTERRUPTED = 130
 
 class StudyError(Exception):
     """A user-facing error of ``evorbc-study``."""
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}")
-    return value
 
 
 def _only(text: str) -> tuple[str, str]:
@@ -51,7 +41,7 @@ def _only(text: str) -> tuple[str, str]:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``evorbc-study``."""
-    p = argparse.ArgumentParser(
+    p = OneLineParser(
         prog="evorbc-study",
         description="Run the paper's studies (a grid of settings x seeds of ordinary "
         "evorbc-evolve runs), locally or on a Ray cluster, and report them.",
@@ -68,12 +58,12 @@ def build_parser() -> argparse.ArgumentParser:
         if name == "run":
             s.add_argument(
                 "--jobs",
-                type=_positive_int,
+                type=integer_in(1),
                 help="runs at once on this machine (default: one per core)",
             )
             s.add_argument(
                 "--threads",
-                type=_positive_int,
+                type=integer_in(1),
                 default=1,
                 help="numba threads per run (default 1; results do not depend on it)",
             )
@@ -95,7 +85,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     rep.add_argument(
         "--replay-runs",
-        type=_positive_int,
+        type=integer_in(1),
         metavar="N",
         help="replay at most N runs per setting for the selection heatmaps (default: all)",
     )
@@ -115,12 +105,12 @@ def _study_options(p: argparse.ArgumentParser, protocol: bool = True) -> None:
         return
     p.add_argument(
         "--seeds",
-        type=_positive_int,
+        type=integer_in(1),
         help="reduced protocol: seeds 1..N per setting (default: the study file's)",
     )
     p.add_argument(
         "--generations",
-        type=_positive_int,
+        type=integer_in(1),
         help="reduced protocol: NEAT generations of every run (default: the study file's)",
     )
     p.add_argument(
