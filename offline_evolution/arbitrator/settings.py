@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -59,10 +60,22 @@ def _resolve(name: str) -> Path:
 def load_run_settings(
     path: str | os.PathLike | None = None, robot: str = DEFAULT_ROBOT
 ) -> ArbitratorRunSettings:
-    """Settings from ``path``, by default the arbitrator settings file of ``robot``."""
+    """Settings from ``path``, by default the arbitrator settings file of ``robot``.
+
+    Relative ``neat`` and ``task`` paths are from ``config/``; one found only beside this
+    file is taken from there, so a robot in its own package ships its settings together
+    (docs/your-robot.md).
+    """
     if path is None:
         path = lookup(robot).settings_file("arbitrator")
     settings = build_settings(ArbitratorRunSettings, load_yaml_mapping(path), str(path))
+    beside = {}
+    for key in ("neat", "task"):
+        name = getattr(settings, key)
+        local = Path(path).parent / name
+        if not _resolve(name).is_file() and local.is_file():
+            beside[key] = str(local.resolve())
+    settings = dataclasses.replace(settings, **beside)
     # The files it refers to, checked here so that an error names this file and key.
     for key, target in (("neat", settings.neat_path()), ("task", settings.task_path())):
         if not target.is_file():
