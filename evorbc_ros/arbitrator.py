@@ -38,8 +38,9 @@ from evorbc_ros.input_files import ARBITRATOR_LIMIT
 from evorbc_ros.json_files import load_json_file
 from evorbc_ros.mapping import MAPPINGS, MappingFunction, PrimitiveLookup, choose_primitive
 from evorbc_ros.network import NetworkError, NetworkSpec
-from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire, robot_problem
+from evorbc_ros.repertoire import Repertoire, robot_problem
 from evorbc_ros.robots.primitive import ParameterSpec
+from evorbc_ros.robots.registry import lookup
 from evorbc_ros.sensors import SensorLayout
 
 FORMAT = "evorbc-arbitrator"
@@ -212,10 +213,11 @@ class ArbitratorFile:
             raise ArbitratorError(
                 f"{head}: it is for robot {repertoire.robot}, the arbitrator for {self.robot}"
             )
-        if repertoire.n_parameters != ROBOT_PARAMETERS[self.robot]:  # made in memory
+        expected_parameters = lookup(self.robot).n_parameters
+        if repertoire.n_parameters != expected_parameters:  # made in memory
             raise ArbitratorError(
                 f"{head}: its primitives have {repertoire.n_parameters} parameters, "
-                f"robot {self.robot} has {ROBOT_PARAMETERS[self.robot]}"
+                f"robot {self.robot} has {expected_parameters}"
             )
         expected = (self.repertoire or {}).get("fingerprint")
         got = repertoire.fingerprint()

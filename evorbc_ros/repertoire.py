@@ -36,15 +36,11 @@ import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.json_files import load_json_file
-from evorbc_ros.robots.four_ws import ROBOT_TYPES
-from evorbc_ros.robots.hexapod import HEXAPOD, N_PARAMETERS
+from evorbc_ros.robots import registry
 from evorbc_ros.robots.primitive import GENE_HIGH, GENE_LOW, ParameterSpec
 
 FORMAT = "evorbc-repertoire"
 VERSION = 1
-
-#: Locomotion parameters (genes) of a primitive of each robot a repertoire can be for.
-ROBOT_PARAMETERS = {**{n: t.n_parameters for n, t in ROBOT_TYPES.items()}, HEXAPOD: N_PARAMETERS}
 
 #: Names of the quality metrics. They are defined in offline_evolution.quality, which this
 #: onboard package must not import; a test keeps the two lists equal.
@@ -282,10 +278,14 @@ def _require(data: dict, key: str, kind, source: str, prefix: str = ""):
 
 
 def robot_problem(robot: Any, n_parameters: int | None = None) -> str | None:
-    """Why ``robot`` (with ``n_parameters`` genes, if given) is no robot we know, or None."""
-    if not isinstance(robot, str) or robot not in ROBOT_PARAMETERS:
-        return f"robot {robot!r} is not known; known robots: {', '.join(ROBOT_PARAMETERS)}"
-    expected = ROBOT_PARAMETERS[robot]
+    """Why ``robot`` (with ``n_parameters`` genes, if given) is no robot we know, or None.
+
+    Known robots are those of the robot registry (:mod:`evorbc_ros.robots.registry`),
+    plugins included.
+    """
+    if not registry.known(robot):
+        return f"robot {robot!r} is not known; known robots: {', '.join(registry.names())}"
+    expected = registry.lookup(robot).n_parameters
     if n_parameters is not None and n_parameters != expected:
         return f"robot {robot} has {expected} parameters, the file has {n_parameters}"
     return None

@@ -7,9 +7,10 @@ settings and refuses, in one line that names the setting and what to lower, a ru
 would need more than :data:`SHARE` of the machine's physical memory (``os.sysconf``).
 
 The constants are measured, rounded up (bench notes in docs/performance.md): the 4WS
-kernel keeps about 350 bytes per episode of a generation, a recorded replay about 100
-bytes per control cycle, a repertoire about 400 bytes per primitive of a batch and
-``(parameters + 8) x 8`` bytes per archive cell.
+kernel keeps about 350 bytes per episode of a generation (each robot's registration gives
+its own figure, ``episode_bytes``), a recorded replay about 100 bytes per control cycle,
+a repertoire about 400 bytes per primitive of a batch and ``(parameters + 8) x 8`` bytes
+per archive cell.
 """
 
 from __future__ import annotations
@@ -18,13 +19,11 @@ import math
 import os
 
 from evorbc_ros.config import ConfigError
+from evorbc_ros.robots.registry import lookup
 
 #: The share of the machine's physical memory a run may plan to use.
 SHARE = 0.5
 GIB = 1 << 30
-#: Bytes per episode of one evaluation call (state, start, results, index arrays). The
-#: hexapod's episodes also carry their network and results between processes.
-EPISODE_BYTES = {"4ws": 400, "hexapod": 16_000}
 #: Bytes per recorded control cycle of a replay: pose (3), choice (1), outputs; x 1.3
 #: for the temporaries of the report.
 CYCLE_BYTES_PER_VALUE = 8 * 1.3
@@ -65,11 +64,6 @@ def check_memory(need: float, what: str, advice: str) -> None:
         )
 
 
-def family(robot: str) -> str:
-    """``hexapod`` or ``4ws``: the robot family whose constants apply."""
-    return "hexapod" if robot == "hexapod" else "4ws"
-
-
 def check_evolution_memory(
     task, pop_size: int, robot: str, source: str, post_candidates: int, post_samples: int
 ) -> None:
@@ -83,7 +77,7 @@ def check_evolution_memory(
         post_samples: its random starts per maze (plus the nominal one).
     """
     mazes = len(task.mazes)
-    per_episode = EPISODE_BYTES[family(robot)]
+    per_episode = lookup(robot).episode_bytes
     generation = pop_size * mazes * task.samples_per_maze
     post = post_candidates * mazes * (post_samples + 1)
     check_memory(
@@ -103,7 +97,7 @@ def check_evolution_memory(
 def replay_bytes(episodes: int, n_cycles: int, n_outputs: int, robot: str) -> float:
     """Bytes of a recorded replay of ``episodes`` episodes of ``n_cycles`` cycles."""
     trace = (n_cycles + 1) * (4 + n_outputs) * CYCLE_BYTES_PER_VALUE
-    return BASE_BYTES + episodes * (EPISODE_BYTES[family(robot)] + trace)
+    return BASE_BYTES + episodes * (lookup(robot).episode_bytes + trace)
 
 
 def check_replay_memory(
@@ -123,10 +117,7 @@ def check_replay_memory(
 
 def repertoire_cells(robot: str, eval_time: float, bin_size: float) -> int:
     """Cells of a repertoire run's archive (grid or CVT: as many), from its settings."""
-    from evorbc_ros.robots.four_ws import FourWSGeometry
-    from sim_bridge.robots.hexapod import SPEED_BOUND
-
-    speed = SPEED_BOUND if robot == "hexapod" else FourWSGeometry().max_speed
+    speed = lookup(robot).max_speed  # m/s: the archive spans speed x T each way
     half = max(0, math.ceil(speed * eval_time / bin_size - 0.5))
     return (2 * half + 1) ** 2
 

@@ -54,11 +54,12 @@ from evorbc_ros.nodes.common import (
     init_ros,
     logged_startup,
     quiet_teardown,
+    robot_named,
     running,
     stop_requested,
 )
-from evorbc_ros.robots.hexapod import HEXAPOD
-from sim_bridge.graph import default_maze
+from evorbc_ros.robots import registry
+from evorbc_ros.robots.registry import DEFAULT_ROBOT
 
 
 def stamp(seconds: float) -> Time:
@@ -68,13 +69,14 @@ def stamp(seconds: float) -> Time:
 
 
 class SimBridgeNode(Node):
-    """The simulated robot (4WS or hexapod) in a maze."""
+    """The simulated robot (any registered robot: 4WS, hexapod, a plugin's) in a maze."""
 
     def __init__(self, **kwargs) -> None:
         super().__init__("sim_bridge", **kwargs)
         with logged_startup(self):
             maze_name = declare(self, "maze", "obstacle", "maze name or maze YAML file")
-            robot = declare(self, "robot", "4ws-5", "robot type")
+            robot = declare(self, "robot", DEFAULT_ROBOT, "robot type")
+            spec = robot_named(robot)
             self.mode = declare(self, "mode", "lockstep", "lockstep or realtime")
             gui = declare(self, "gui", False, "open the PyBullet GUI window")
             start = declare(self, "start", "nominal", "nominal, random, or 'x,y,heading_deg'")
@@ -82,8 +84,8 @@ class SimBridgeNode(Node):
             episode_time = finite_parameter(
                 self,
                 "episode_time",
-                30.0 if robot == HEXAPOD else 120.0,
-                "episode length T (s; default 120, hexapod 30)",
+                spec.episode_time,
+                "episode length T (s; default: the robot's, 120 for 4WS, 30 for the hexapod)",
                 positive=True,
             )
             self.lockstep_timeout = finite_parameter(
@@ -102,15 +104,7 @@ class SimBridgeNode(Node):
             self.wait_publishers = declare(
                 self,
                 "wait_for_publishers",
-                (
-                    ["joint_trajectory_controller/joint_trajectory"]
-                    if robot == HEXAPOD
-                    else [
-                        "steering_position_controller/commands",
-                        "wheel_velocity_controller/commands",
-                    ]
-                )
-                + ["evorbc/primitive"],
+                [*spec.command_topics, "evorbc/primitive"],
                 "topics that need a publisher before the run starts",
             )
             self.startup_timeout = finite_parameter(
@@ -139,7 +133,7 @@ class SimBridgeNode(Node):
             except ConfigError as e:
                 raise StartupError(f"parameter maze: {e}") from None
             kind = bridge_robot_class(robot)
-            pose = self._start_pose(maze, start, seed, kind.geometry_type().footprint_radius, robot)
+            pose = self._start_pose(maze, start, seed, spec.footprint_radius, robot)
             self.robot = kind(self, robot, maze, pose, episode_time, gui)
         self.world = self.robot.world
         self.trajectory = [list(self.world.pose)]
@@ -177,9 +171,8 @@ class SimBridgeNode(Node):
         room = maze.clearance(x, y)
         if start in ("nominal", "random") and room < clearance:
             # Not the user's start: the maze's own start region is too narrow for it.
-            hint = (
-                "" if maze.name == default_maze(robot) else f"; its maze is {default_maze(robot)}"
-            )
+            own = registry.lookup(robot).maze if registry.known(robot) else maze.name
+            hint = "" if maze.name == own else f"; its maze is {own}"
             raise StartupError(
                 f"robot {robot} does not fit maze {maze.name}: at the maze's start "
                 f"({x:.2f}, {y:.2f}) m the nearest wall is {room:.3f} m away, and the robot "

@@ -3,7 +3,8 @@
 Each adapter owns its simulated world, subscribes its command topics, fills the joint
 states and laser scan, and steps the world with the commands of the cycle. The bridge node
 (:mod:`sim_bridge.bridge_node`) runs the loop, clock, odometry and result the same way for
-both.
+every robot, and finds a robot's adapter through its registration's ``bridge`` field
+(docs/your-robot.md gives the adapter's interface).
 """
 
 from __future__ import annotations
@@ -17,14 +18,14 @@ from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
 from evorbc_ros.nodes.common import RELIABLE, StartupError, declare, finite_parameter
-from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES, FourWSGeometry
-from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES, HexapodGeometry
+from evorbc_ros.robots.four_ws import WHEEL_NAMES
+from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES
+from evorbc_ros.robots.registry import RobotError
 from sim_bridge.hexapod.maze_world import HexapodMazeWorld
 from sim_bridge.world import LaserConfig, SimWorld
 
 STEERING_JOINTS = [f"{w}_steering_joint" for w in WHEEL_NAMES]
 WHEEL_JOINTS = [f"{w}_wheel_joint" for w in WHEEL_NAMES]
-ROBOTS = (*ROBOT_TYPES, HEXAPOD)
 
 
 @dataclass(frozen=True)
@@ -43,7 +44,6 @@ class FourWSBridge:
 
     #: Command topics the lockstep loop waits for each cycle (parameter names).
     command_keys = ("steering", "wheel")
-    geometry_type = FourWSGeometry  # its footprint_radius keeps random starts off walls
 
     def __init__(self, node, robot: str, maze, pose, episode_time: float, gui: bool) -> None:
         self.node = node
@@ -140,7 +140,6 @@ class HexapodBridge:
     """The hexapod: a JointTrajectory of targets per control period, PyBullet dynamics."""
 
     command_keys = ("trajectory",)
-    geometry_type = HexapodGeometry
 
     def __init__(self, node, robot: str, maze, pose, episode_time: float, gui: bool) -> None:
         self.node = node
@@ -246,8 +245,16 @@ class HexapodBridge:
         msg.effort = tau.tolist()
 
 
-def bridge_robot_class(robot: str) -> type[FourWSBridge] | type[HexapodBridge]:
-    """The adapter class for ``robot``."""
-    if robot not in ROBOTS:
-        raise StartupError(f"parameter robot must be one of {', '.join(ROBOTS)}")
-    return HexapodBridge if robot == HEXAPOD else FourWSBridge
+def bridge_robot_class(robot: str) -> type:
+    """The adapter class ``robot``'s registration names.
+
+    Raises:
+        StartupError: an unknown robot (listing the known ones), or an adapter that cannot
+            be imported.
+    """
+    from evorbc_ros.nodes.common import robot_named
+
+    try:
+        return robot_named(robot).load("bridge")
+    except RobotError as e:
+        raise StartupError(str(e)) from None

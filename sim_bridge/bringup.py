@@ -23,19 +23,15 @@ from pathlib import Path
 from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.cli_support import OneLineParser, check_output_file, integer_in, report_unexpected
-from evorbc_ros.config import ConfigError, config_dir
-from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, shipped_robots
+from evorbc_ros.config import ConfigError
+from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, ships_controller
 from evorbc_ros.nodes.common import StartupError
 from evorbc_ros.repertoire import RepertoireError
-from evorbc_ros.robots.hexapod import HEXAPOD, HexapodGeometry
-from evorbc_ros.sensors import SensorLayout
+from evorbc_ros.robots import registry
+from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
 from sim_bridge.bridge_node import SimBridgeNode, episode_verdict
-from sim_bridge.bridge_robots import ROBOTS, bridge_robot_class
 from sim_bridge.graph import NodeSpec, exit_ends_graph, sim_graph
-from sim_bridge.hexapod.maze_world import DEFAULT_SENSORS
-from sim_bridge.hexapod.physics import PhysicsSettings
 from sim_bridge.maze import Maze, load_named_maze, maze_names
-from sim_bridge.robots.hexapod import check_simulation, describe_simulation, simulation_mismatch
 
 #: Highest ROS_DOMAIN_ID: DDS derives UDP ports from it, and above 232 they pass 65535.
 MAX_DOMAIN_ID = 232
@@ -53,7 +49,7 @@ def parse_args(argv=None) -> argparse.Namespace:
     )
     p.add_argument(
         "--robot",
-        choices=ROBOTS,
+        choices=ROBOT_NAMES,
         default="",
         help="robot whose shipped controller runs (default: the arbitrator file's, else 4ws-5; "
         "4ws-5 and hexapod ship one)",
@@ -62,7 +58,7 @@ def parse_args(argv=None) -> argparse.Namespace:
         "--maze",
         default="",
         help=f"maze name ({', '.join(maze_names())}) or file "
-        "(default: obstacle for 4WS robots, hexapod for the hexapod)",
+        "(default: the robot's: obstacle for 4WS robots, hexapod for the hexapod)",
     )
     p.add_argument(
         "--arbitrator", default="", help="arbitrator file (default: the shipped one for --robot)"
@@ -151,33 +147,6 @@ class Graph:
                 proc.wait()
 
 
-def check_design(controller: Controller) -> None:
-    """Refuse a hexapod controller evolved for another design or laser than the bridge's.
-
-    Raises:
-        ConfigError: one line naming the file and the first setting that differs.
-
-    """
-    # The bridge simulates the shipped laser; the sensor nodes read its scans with the
-    # arbitrator's layout, so another layout would feed the network inputs it never saw.
-    laser = SensorLayout.load(config_dir() / DEFAULT_SENSORS)
-    if controller.spec.sensors.fingerprint() != laser.fingerprint():
-        raise ConfigError(
-            f"{controller.arbitrator_path}: its sensor layout differs from the laser the "
-            f"bridge simulates (config/{DEFAULT_SENSORS}: 25 beams over +-90 deg, grouped "
-            "into 5)"
-        )
-    bridge = describe_simulation(HexapodGeometry(), PhysicsSettings())
-    if controller.repertoire is not None:
-        check_simulation(controller.repertoire, bridge, controller.repertoire_path)
-    recorded = controller.spec.evolution.get("simulation")
-    mismatch = simulation_mismatch(recorded, bridge, "the controller")
-    if mismatch:
-        raise ConfigError(
-            f"{controller.arbitrator_path}: was evolved for a different robot ({mismatch})"
-        )
-
-
 def start_graph(
     graph: Graph, args: argparse.Namespace, robot: str, arb_path: str, result_file: str
 ) -> subprocess.Popen:
@@ -204,7 +173,7 @@ def check_start(start: str, seed: int, maze: Maze, robot: str) -> None:
         ConfigError: one line naming ``--start``.
 
     """
-    clearance = bridge_robot_class(robot).geometry_type().footprint_radius
+    clearance = registry.lookup(robot).footprint_radius
     try:
         # The bridge's own check, so that both refuse the same starts.
         x, y, _ = SimBridgeNode._start_pose(maze, start, seed, clearance, robot)
@@ -230,19 +199,19 @@ def prepare(args: argparse.Namespace) -> tuple[Controller, Maze, str]:
         The controller the arbitrator node will load, the maze and the picture path.
 
     """
-    if not args.arbitrator and args.robot and args.robot not in shipped_robots():
+    if not args.arbitrator and args.robot and not ships_controller(args.robot):
         raise ConfigError(
             f"{no_shipped_controller(args.robot)}, then run "
             "'evorbc-sim --arbitrator a.json --repertoire r.json'"
         )
-    arb_path = args.arbitrator or str(default_arbitrator(args.robot or "4ws-5"))
+    arb_path = args.arbitrator or str(default_arbitrator(args.robot or DEFAULT_ROBOT))
     controller = Controller(arb_path, args.repertoire)
     arb = controller.spec
     if args.robot and arb.robot != args.robot:
         raise ConfigError(f"{arb_path}: is for robot {arb.robot}, not --robot {args.robot}")
-    if arb.robot == HEXAPOD:
-        check_design(controller)
-    args.maze = args.maze or ("hexapod" if arb.robot == HEXAPOD else "obstacle")
+    robot = registry.lookup(arb.robot)
+    robot.check_design(controller)  # e.g. the hexapod: the bridge's design and laser
+    args.maze = args.maze or robot.maze
     maze = load_named_maze(args.maze)
     check_start(args.start, args.seed, maze, arb.robot)
     plot = args.plot or f"{maze.name}-run.png"

@@ -19,10 +19,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from evorbc_ros.config import ConfigError, config_dir
-from evorbc_ros.defaults import default_arbitrator, shipped_robots
+from evorbc_ros.defaults import default_arbitrator, ships_controller
+from evorbc_ros.robots import registry
+from evorbc_ros.robots.registry import DEFAULT_ROBOT
 
-#: Robot types of the simulation (the 4WS types and the hexapod).
-SIM_ROBOTS = ("2ws-2", "2ws-3", "4ws-3", "4ws-5", "hexapod")
 MODES = ("lockstep", "realtime")
 
 
@@ -39,15 +39,15 @@ class Argument:
 ARGUMENTS = (
     Argument(
         "robot",
-        "4ws-5",
-        f"robot type: {', '.join(SIM_ROBOTS)}; the arbitrator refuses a controller for "
+        DEFAULT_ROBOT,
+        f"robot type: {', '.join(registry.names())}; the arbitrator refuses a controller for "
         "another robot",
     ),
     Argument(
         "maze",
         "",
         "maze name (obstacle, zigzag, baffles, corridors, gaps, hexapod) or maze YAML file; "
-        "empty: obstacle, or hexapod for the hexapod",
+        "empty: the robot's (obstacle, or hexapod for the hexapod)",
     ),
     Argument(
         "mode", "lockstep", "lockstep (deterministic, as fast as the graph) or realtime (10 Hz)"
@@ -109,16 +109,16 @@ class SimGraph:
 
 def shipped_arbitrator(robot: str) -> str:
     """The shipped arbitrator file for ``robot``, or "" if none ships for it."""
-    return str(default_arbitrator(robot)) if robot in shipped_robots() else ""
+    return str(default_arbitrator(robot)) if ships_controller(robot) else ""
 
 
 def default_maze(robot: str) -> str:
-    """The maze a robot runs in when none is named: obstacle (4WS) or hexapod."""
-    return "hexapod" if robot == "hexapod" else "obstacle"
+    """The maze a robot runs in when none is named (its registration's: obstacle for 4WS)."""
+    return registry.lookup(robot).maze
 
 
 def sim_graph(
-    robot: str = "4ws-5",
+    robot: str = DEFAULT_ROBOT,
     maze: str = "",
     mode: str = "lockstep",
     gui: bool = False,
@@ -135,8 +135,8 @@ def sim_graph(
     Raises:
         ConfigError: an unknown robot or mode (one line naming the argument).
     """
-    if robot not in SIM_ROBOTS:
-        raise ConfigError(f"robot must be one of {', '.join(SIM_ROBOTS)}, got {robot!r}")
+    if not registry.known(robot):
+        raise ConfigError(f"robot must be one of {', '.join(registry.names())}, got {robot!r}")
     if mode not in MODES:
         raise ConfigError(f"mode must be lockstep or realtime, got {mode!r}")
     arbitrator = arbitrator or shipped_arbitrator(robot)

@@ -23,16 +23,16 @@ from std_msgs.msg import Float64MultiArray
 
 from evorbc_ros.arbitration import Controller, InputGroups
 from evorbc_ros.arbitrator import ArbitratorError
-from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, shipped_robots
+from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, ships_controller
 from evorbc_ros.laser import InputError
 from evorbc_ros.nodes.common import (
     DIAGNOSTICS,
     RELIABLE,
-    ROBOTS,
     StartupError,
     declare,
     load_sensor_layout,
     logged_startup,
+    robot_named,
     run_node,
     vector_message,
     vector_values,
@@ -62,8 +62,8 @@ class ArbitratorNode(Node):
                 self,
                 "robot",
                 "",
-                f"the robot driven ({', '.join(ROBOTS)}): a controller for another is refused; "
-                "empty: not checked",
+                "the robot driven (a registered robot, e.g. 4ws-5 or hexapod): a controller "
+                "for another is refused; empty: not checked",
             )
             allow = declare(
                 self,
@@ -197,10 +197,10 @@ def load_controller(
     Raises:
         StartupError: one line naming the parameter or file and the problem.
     """
-    if robot and robot not in ROBOTS:
-        raise StartupError(f"parameter robot must be one of {', '.join(ROBOTS)}, got {robot!r}")
+    if robot:
+        robot_named(robot)
     if not arbitrator and robot:
-        if robot not in shipped_robots():
+        if not ships_controller(robot):
             raise StartupError(
                 f"parameter robot: {no_shipped_controller(robot)}; then set "
                 "arbitrator:=a.json and repertoire:=r.json"

@@ -49,17 +49,6 @@ LATCHED = QoSProfile(
 SENSOR_DATA = qos_profile_sensor_data
 
 
-def _robot_names() -> tuple[str, ...]:
-    from evorbc_ros.robots.four_ws import ROBOT_TYPES
-    from evorbc_ros.robots.hexapod import HEXAPOD
-
-    return (*ROBOT_TYPES, HEXAPOD)
-
-
-#: Every robot type the nodes drive: the 4WS types (2ws-2, 2ws-3, 4ws-3, 4ws-5), hexapod.
-ROBOTS = _robot_names()
-
-
 class StartupError(Exception):
     """A node cannot start (bad parameter or file); the message says which and why."""
 
@@ -284,19 +273,37 @@ def declare(
         ) from None
 
 
+def robot_named(name: str):
+    """The registered robot (:mod:`evorbc_ros.robots.registry`) a ``robot`` parameter names.
+
+    Raises:
+        StartupError: one line listing the known robots.
+    """
+    from evorbc_ros.robots import registry
+
+    if not registry.known(name):
+        raise StartupError(
+            f"parameter robot must be one of {', '.join(registry.names())}, got {name!r}"
+        )
+    return registry.lookup(name)
+
+
 def load_sensor_layout(path: str):
-    """The sensor layout from a layout YAML, an arbitrator file, or the shipped 4WS layout.
+    """The sensor layout from a layout YAML, an arbitrator file, or the default robot's.
+
+    The default robot's layout is the shipped 4WS one.
 
     Raises:
         StartupError: naming the file and the problem.
     """
     from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
-    from evorbc_ros.config import ConfigError, config_dir
+    from evorbc_ros.config import ConfigError
+    from evorbc_ros.robots.registry import DEFAULT_ROBOT, lookup
     from evorbc_ros.sensors import SensorLayout
 
     try:
         if not path:
-            return SensorLayout.load(config_dir() / "sensors" / "4ws.yaml")
+            return SensorLayout.load(lookup(DEFAULT_ROBOT).sensors_file())
         if path.endswith(".json"):
             return ArbitratorFile.load(path).sensors
         return SensorLayout.load(path)

@@ -1,16 +1,21 @@
 """``primitive_executor``: runs the current primitive on the robot's controllers.
 
 Subscribes ``evorbc/primitive`` (genes) and, to know that the sensors are alive,
-``evorbc/rangefinders`` and ``evorbc/goal_sectors``. Publishes, following ros2_control's
-command conventions (reliable):
+``evorbc/rangefinders`` and ``evorbc/goal_sectors``. What it publishes is the robot's
+command interface, named by its registration (:mod:`evorbc_ros.robots.registry`),
+following ros2_control's command conventions (reliable):
 
-* 4WS robots, forward command controllers (std_msgs/Float64MultiArray):
-  ``steering_position_controller/commands``, the four steering angles (rad; fl, fr, rl,
-  rr), and ``wheel_velocity_controller/commands``, the four wheel velocities (rad/s).
-* the hexapod, joint_trajectory_controller (trajectory_msgs/JointTrajectory):
-  ``joint_trajectory_controller/joint_trajectory``, the 18 joints' targets (rad) for the
-  next ``stale_timeout`` s, one point per physics step (``trajectory_rate``, 50 Hz), see
-  :mod:`evorbc_ros.hexapod_executor`.
+* 4WS robots (:mod:`evorbc_ros.nodes.wheel_commands`), forward command controllers
+  (std_msgs/Float64MultiArray): ``steering_position_controller/commands``, the four
+  steering angles (rad; fl, fr, rl, rr), and ``wheel_velocity_controller/commands``, the
+  four wheel velocities (rad/s).
+* the hexapod (:mod:`evorbc_ros.nodes.trajectory_commands`), joint_trajectory_controller
+  (trajectory_msgs/JointTrajectory): ``joint_trajectory_controller/joint_trajectory``,
+  the 18 joints' targets (rad) for the next ``stale_timeout`` s, one point per physics
+  step (``trajectory_rate``, 50 Hz), see :mod:`evorbc_ros.hexapod_executor`.
+
+The node declares the parameters of both (topics, ``wheel_radius``, ``trajectory_rate``),
+whichever robot it drives, so one parameter file serves every robot.
 
 A command goes out at once for every new primitive, and again whenever 1.5 periods
 (0.15 s) pass without one, so the controllers keep receiving 10 Hz commands. If
@@ -29,30 +34,27 @@ from __future__ import annotations
 
 import sys
 
-from builtin_interfaces.msg import Duration
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64MultiArray
-from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from evorbc_ros.executor import NO_PRIMITIVE_REASON, PrimitiveExecutor, WheelCommand
-from evorbc_ros.hexapod_executor import HexapodExecutor, JointTargets
+from evorbc_ros.executor import NO_PRIMITIVE_REASON
 from evorbc_ros.laser import InputError
 from evorbc_ros.nodes.common import (
     RELIABLE,
-    ROBOTS,
     StartupError,
     declare,
     finite_parameter,
     finite_problem,
     logged_startup,
     now_seconds,
+    robot_named,
     run_node,
-    vector_message,
 )
-from evorbc_ros.robots.four_ws import ROBOT_TYPES, WHEEL_NAMES, FourWSGeometry
-from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES, SERVO_RATE, parameter_specs
+from evorbc_ros.robots import registry
+from evorbc_ros.robots.hexapod import SERVO_RATE
+from evorbc_ros.robots.registry import DEFAULT_ROBOT, RobotError
 
 
 class PrimitiveExecutorNode(Node):
@@ -61,11 +63,10 @@ class PrimitiveExecutorNode(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__("primitive_executor", **kwargs)
         with logged_startup(self):
-            robot = declare(self, "robot", "4ws-5", f"robot type: {', '.join(ROBOTS)}")
-            if robot not in ROBOTS:
-                raise StartupError(
-                    f"parameter robot must be one of {', '.join(ROBOTS)}, got {robot!r}"
-                )
+            robot = declare(
+                self, "robot", DEFAULT_ROBOT, "robot type (a registered robot, e.g. 4ws-5)"
+            )
+            spec = robot_named(robot)
             self.wheel_radius = finite_parameter(
                 self,
                 "wheel_radius",
@@ -98,42 +99,41 @@ class PrimitiveExecutorNode(Node):
                 ["evorbc/rangefinders", "evorbc/goal_sectors"],
                 "sensor topics whose silence stops the robot",
             )
-            steering_topic = declare(
+            declare(
                 self,
                 "steering_topic",
                 "steering_position_controller/commands",
                 "steering angles (Float64MultiArray, rad)",
             )
-            wheel_topic = declare(
+            declare(
                 self,
                 "wheel_topic",
                 "wheel_velocity_controller/commands",
                 "wheel velocities (Float64MultiArray, rad/s)",
             )
-            trajectory_topic = declare(
+            declare(
                 self,
                 "trajectory_topic",
                 "joint_trajectory_controller/joint_trajectory",
                 "hexapod joint targets (JointTrajectory, rad)",
             )
-            rate = finite_parameter(
+            finite_parameter(
                 self,
                 "trajectory_rate",
                 SERVO_RATE,
                 "hexapod trajectory points per second (the simulation's physics rate)",
                 positive=True,
             )
+            try:
+                interface = spec.load("commands")
+            except RobotError as e:
+                raise StartupError(str(e)) from None
         self.robot = robot
-        self.parameter_names = robot_parameter_names(robot)
+        self.parameter_names = list(spec.parameter_names)
         self.primitive_topic = primitive_topic
-        if robot == HEXAPOD:
-            self.logic = HexapodExecutor(list(inputs), stale, rate)
-            self.trajectory_pub = self.create_publisher(JointTrajectory, trajectory_topic, RELIABLE)
-        else:
-            geometry = FourWSGeometry()
-            self.logic = PrimitiveExecutor(ROBOT_TYPES[robot], geometry, list(inputs), stale)
-            self.steering_pub = self.create_publisher(Float64MultiArray, steering_topic, RELIABLE)
-            self.wheel_pub = self.create_publisher(Float64MultiArray, wheel_topic, RELIABLE)
+        # The robot's own command interface: the executor logic and its publishers.
+        self.commands = interface(self, spec, list(inputs), stale)
+        self.logic = self.commands.logic
         self.subs = [
             self.create_subscription(
                 Float64MultiArray, primitive_topic, self.on_primitive_message, RELIABLE
@@ -185,11 +185,7 @@ class PrimitiveExecutorNode(Node):
             )
             return
         command = self.logic.command(now)
-        if self.logic.halted and isinstance(command, JointTargets) and not len(command.positions):
-            # No target sent yet, so none to hold: an empty trajectory is ROS's "stop and
-            # hold where you are" for a joint trajectory controller.
-            self.trajectory_pub.publish(JointTrajectory(joint_names=list(JOINT_NAMES)))
-        self.publish(command, now)
+        self.publish(command, now, halt=self.logic.halted)
 
     def on_input(self, topic: str) -> None:
         """Note a sensor input; if the robot was stopped for it, run again at once."""
@@ -213,37 +209,20 @@ class PrimitiveExecutorNode(Node):
         if repeat or now - self.last_publish > 1.5 * self.period:
             self.publish(command, now)
 
-    def publish(self, command: WheelCommand | JointTargets, now: float) -> None:
-        """Send one command to the robot's controllers."""
+    def publish(self, command, now: float, halt: bool = False) -> None:
+        """Send one command through the robot's command interface.
+
+        Args:
+            halt: the command answers the arbitrator's "no primitive".
+
+        """
         if command.stopped and command.reason != self.stopped_reason:
             self.get_logger().warning(f"stopping the robot: {command.reason}")
         elif not command.stopped and self.stopped_reason:
             self.get_logger().info("inputs are back: running the primitive again")
         self.stopped_reason = command.reason if command.stopped else ""
-        if isinstance(command, JointTargets):
-            if len(command.positions):  # none before the first primitive: nothing to hold
-                self.trajectory_pub.publish(trajectory_message(command))
-        else:
-            self.publish_wheels(command)
+        self.commands.publish(command, halt)
         self.last_publish = now
-
-    def publish_wheels(self, command: WheelCommand) -> None:
-        """Steering angles and wheel velocities for a 4WS robot's two controllers."""
-        self.steering_pub.publish(
-            vector_message(command.steering, [f"{w}_steering" for w in WHEEL_NAMES])
-        )
-        self.wheel_pub.publish(
-            vector_message(
-                command.wheel_velocities(self.wheel_radius), [f"{w}_wheel" for w in WHEEL_NAMES]
-            )
-        )
-
-
-def robot_parameter_names(robot: str) -> list[str]:
-    """The names of ``robot``'s primitive parameters, as the arbitrator labels its genes."""
-    if robot == HEXAPOD:
-        return [p.name for p in parameter_specs()]
-    return list(ROBOT_TYPES[robot].parameter_names)
 
 
 def primitive_mismatch(msg: Float64MultiArray, robot: str, names: list[str]) -> str:
@@ -257,7 +236,7 @@ def primitive_mismatch(msg: Float64MultiArray, robot: str, names: list[str]) -> 
     got = label.split(",") if label else []
     if not got or not msg.data or got == names:
         return ""
-    other = next((r for r in ROBOTS if robot_parameter_names(r) == got), None)
+    other = next((r.name for r in registry.robots() if list(r.parameter_names) == got), None)
 
     def listed(n: list[str]) -> str:
         return ", ".join(n) if len(n) <= 6 else f"{len(n)} parameters"
@@ -266,23 +245,6 @@ def primitive_mismatch(msg: Float64MultiArray, robot: str, names: list[str]) -> 
         f"{'a ' + other if other else 'a'} primitive ({listed(got)}): this executor drives "
         f"a {robot} ({listed(names)}); is the arbitrator for another robot?"
     )
-
-
-def trajectory_message(command: JointTargets) -> JointTrajectory:
-    """A JointTrajectory with point ``k`` at ``k * dt`` s (header stamp 0: start on receipt)."""
-    msg = JointTrajectory()
-    msg.joint_names = list(JOINT_NAMES)
-    points = []
-    for k, row in enumerate(command.positions):
-        ns = round(k * command.dt * 1e9)
-        points.append(
-            JointTrajectoryPoint(
-                positions=row.tolist(),
-                time_from_start=Duration(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000),
-            )
-        )
-    msg.points = points
-    return msg
 
 
 def main(argv=None) -> int:

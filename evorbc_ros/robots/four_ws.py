@@ -97,7 +97,11 @@ class FourWSType:
         return (np.clip(genes, -1.0, 1.0) @ self.gene_matrix) * scale
 
 
-def _gene_matrix(rows: list[tuple[int, ...]]) -> np.ndarray:
+def gene_matrix(rows: list[tuple[int, ...]]) -> np.ndarray:
+    """``(len(rows), 5)`` gene matrix: gene ``k`` drives the wheel commands ``rows[k]``.
+
+    Columns are :data:`COMMAND_NAMES` indices (0 speed, 1-4 the fl, fr, rl, rr angles).
+    """
     matrix = np.zeros((len(rows), len(COMMAND_NAMES)))
     for k, columns in enumerate(rows):
         matrix[k, list(columns)] = 1.0
@@ -109,29 +113,33 @@ def _gene_matrix(rows: list[tuple[int, ...]]) -> np.ndarray:
 ROBOT_TYPES: dict[str, FourWSType] = {
     t.name: t
     for t in (
-        FourWSType("2ws-2", ("speed", "angle_front"), _gene_matrix([(0,), (1, 2)])),
-        FourWSType("2ws-3", ("speed", "angle_fl", "angle_fr"), _gene_matrix([(0,), (1,), (2,)])),
+        FourWSType("2ws-2", ("speed", "angle_front"), gene_matrix([(0,), (1, 2)])),
+        FourWSType("2ws-3", ("speed", "angle_fl", "angle_fr"), gene_matrix([(0,), (1,), (2,)])),
         FourWSType(
-            "4ws-3", ("speed", "angle_front", "angle_rear"), _gene_matrix([(0,), (1, 2), (3, 4)])
+            "4ws-3", ("speed", "angle_front", "angle_rear"), gene_matrix([(0,), (1, 2), (3, 4)])
         ),
         FourWSType(
             "4ws-5",
             ("speed", "angle_fl", "angle_fr", "angle_rl", "angle_rr"),
-            _gene_matrix([(0,), (1,), (2,), (3,), (4,)]),
+            gene_matrix([(0,), (1,), (2,), (3,), (4,)]),
         ),
     )
 }
 
 
 def robot_type(name: str) -> FourWSType:
-    """The 4WS robot type called ``name`` (``2ws-2``, ``2ws-3``, ``4ws-3`` or ``4ws-5``).
+    """The 4WS robot type called ``name``: a built-in one, or a plugin's 4WS variant.
+
+    Looked up in the robot registry (:mod:`evorbc_ros.robots.registry`), whose 4WS
+    registrations carry their type as ``model``.
 
     Raises:
-        KeyError: with a message listing the known types.
+        KeyError: with a message listing the known 4WS types.
 
     """
-    try:
-        return ROBOT_TYPES[name]
-    except KeyError:
-        known = ", ".join(ROBOT_TYPES)
-        raise KeyError(f"unknown 4WS robot type {name!r}; expected one of {known}") from None
+    from evorbc_ros.robots import registry
+
+    if registry.known(name) and isinstance(registry.lookup(name).model, FourWSType):
+        return registry.lookup(name).model
+    known = ", ".join(r.name for r in registry.robots() if isinstance(r.model, FourWSType))
+    raise KeyError(f"unknown 4WS robot type {name!r}; expected one of {known}")

@@ -52,6 +52,12 @@ RHO_LOW, RHO_HIGH = math.pi / 8.0, math.pi / 8.0 + 2.0 * math.pi
 #: Number of primitive parameters: rho plus (offset, amplitude, phase) for 12 joints.
 N_PARAMETERS = 1 + 3 * len(EVOLVED_JOINTS)
 
+#: Displacement speed (m/s) no hexapod gait reaches: the archive spans this speed times T
+#: in every direction. The fastest primitives of a 200k-evaluation repertoire reach
+#: 0.51 m/s (1.01 m in 2 s, docs/hexapod.md); anything beyond the bound would be a
+#: simulation blow-up.
+SPEED_BOUND = 0.6
+
 #: Hz, the servo loop: one joint target per physics step of the simulation
 #: (docs/hexapod.md says why 50), so a 0.1 s control period is 5 targets.
 SERVO_RATE = 50.0

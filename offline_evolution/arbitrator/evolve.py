@@ -53,12 +53,9 @@ from offline_evolution.checkpoint import (
     settings_mismatch,
 )
 from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings, make_task
-from sim_bridge.robots.hexapod import check_simulation
+from sim_bridge.robots.design import check_simulation
 
 CHECKPOINT_KIND = "evorbc-neat-checkpoint"
-#: Extra generations that give standard NEAT EvoRBC's budget: the 4WS repertoire costs
-#: about 2M simulated seconds, 25 generations of 150 x 5 x 120 s (paper Sec. IV-C).
-EQUAL_BUDGET_GENERATIONS = {"4ws": 25, "hexapod": 455}
 
 
 #: EvolutionSettings fields that only decide which genome is written, never how the

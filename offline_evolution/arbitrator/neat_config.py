@@ -8,11 +8,10 @@ import math
 import os
 import reprlib
 import tempfile
-from pathlib import Path
 
 import neat
 
-from evorbc_ros.config import INT_LIMIT, ConfigError, config_dir
+from evorbc_ros.config import INT_LIMIT, ConfigError
 from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular_text
 from evorbc_ros.network import ACTIVATIONS, AGGREGATIONS
 from offline_evolution.arbitrator.neat_classes import EvoRBCGenome, TargetSpeciesSet
@@ -33,12 +32,6 @@ INIT_TYPES = ("gaussian", "gauss", "normal", "uniform")
 #: draw from nothing, never stagnate or speciate backwards.
 NON_NEGATIVE_SUFFIXES = ("_stdev", "_mutate_power", "_coefficient")
 NON_NEGATIVE = ("num_hidden", "species_elitism", "max_stagnation", "elitism")
-
-
-def default_neat_file(robot: str) -> Path:
-    """The shipped NEAT settings for ``robot``'s family."""
-    family = "hexapod" if robot == "hexapod" else "4ws"
-    return config_dir() / "neat" / f"{family}.ini"
 
 
 def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int) -> neat.Config:

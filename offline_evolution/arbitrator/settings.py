@@ -1,19 +1,21 @@
-"""Run-level settings of arbitrator evolution (``config/arbitrator/<family>.yaml``)."""
+"""Run-level settings of arbitrator evolution (``config/arbitrator/*.yaml``)."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
 from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
 from evorbc_ros.mapping import MAPPINGS
+from evorbc_ros.robots.registry import DEFAULT_ROBOT, lookup
 from offline_evolution.arbitrator.selection import RULES
 
 
 @dataclass(frozen=True)
 class ArbitratorRunSettings:
-    """Defaults of ``evorbc-evolve arbitrator`` and ``standard`` for a robot family."""
+    """Defaults of ``evorbc-evolve arbitrator`` and ``standard`` for a robot."""
 
     generations: int = setting(doc="NEAT generations", minimum=1)
     mapping: str = setting("polar", doc="mapping function", choices=MAPPINGS)
@@ -56,13 +58,24 @@ def _resolve(name: str) -> Path:
 
 
 def load_run_settings(
-    path: str | os.PathLike | None = None, robot: str = "4ws-5"
+    path: str | os.PathLike | None = None, robot: str = DEFAULT_ROBOT
 ) -> ArbitratorRunSettings:
-    """Settings from ``path``, by default the shipped file of ``robot``'s family."""
+    """Settings from ``path``, by default the arbitrator settings file of ``robot``.
+
+    Relative ``neat`` and ``task`` paths are from ``config/``; one found only beside this
+    file is taken from there, so a robot in its own package ships its settings together
+    (docs/your-robot.md).
+    """
     if path is None:
-        family = "hexapod" if robot == "hexapod" else "4ws"
-        path = config_dir() / "arbitrator" / f"{family}.yaml"
+        path = lookup(robot).settings_file("arbitrator")
     settings = build_settings(ArbitratorRunSettings, load_yaml_mapping(path), str(path))
+    beside = {}
+    for key in ("neat", "task"):
+        name = getattr(settings, key)
+        local = Path(path).parent / name
+        if not _resolve(name).is_file() and local.is_file():
+            beside[key] = str(local.resolve())
+    settings = dataclasses.replace(settings, **beside)
     # The files it refers to, checked here so that an error names this file and key.
     for key, target in (("neat", settings.neat_path()), ("task", settings.task_path())):
         if not target.is_file():

@@ -9,7 +9,8 @@ from collections import deque
 from pathlib import Path
 
 from evorbc_ros.cli_support import check_output_file
-from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire
+from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.robots.registry import ROBOT_NAMES, lookup
 from offline_evolution.commands.common import (
     add_workers_option,
     at_least,
@@ -28,14 +29,14 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         "--generations",
         type=at_least(1),
         metavar="N",
-        help="NEAT generations (default: config/arbitrator/<family>.yaml, Table I)",
+        help="NEAT generations (default: the robot's run settings, Table I)",
     )
     p.add_argument("--seed", type=count, default=0, metavar="N", help="random seed (0)")
     p.add_argument("--out", required=True, metavar="FILE", help="arbitrator file to write (JSON)")
     p.add_argument(
         "--config",
         metavar="FILE.yaml",
-        help="run settings (default: config/arbitrator/<family>.yaml)",
+        help="run settings (default: the robot's, e.g. config/arbitrator/4ws.yaml)",
     )
     p.add_argument("--neat-config", metavar="FILE.ini", help="NEAT settings (neat-python format)")
     p.add_argument("--task", metavar="FILE.yaml", help="maze task settings")
@@ -63,7 +64,6 @@ def _common_options(p: argparse.ArgumentParser) -> None:
 def add_parsers(sub) -> None:
     """Register ``arbitrator`` and ``standard``."""
     from evorbc_ros.mapping import MAPPINGS
-    from sim_bridge.robots import ROBOT_NAMES
 
     arb = sub.add_parser(
         "arbitrator",
@@ -86,8 +86,8 @@ def add_parsers(sub) -> None:
     std.add_argument(
         "--equal-budget",
         action="store_true",
-        help="add the generations that match EvoRBC's repertoire budget (+25 for the 4WS "
-        "robots, +455 for the hexapod)",
+        help="add the generations that match EvoRBC's repertoire budget (the robot's: +25 "
+        "for the 4WS robots, +455 for the hexapod)",
     )
     _common_options(std)
     std.set_defaults(func=cmd_evolve, kind="standard")
@@ -167,7 +167,6 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     from evorbc_ros.config import config_dir
     from evorbc_ros.sensors import SensorLayout
     from offline_evolution.arbitrator.evolve import (
-        EQUAL_BUDGET_GENERATIONS,
         EvolutionSettings,
         arbitrator_file,
         file_sha256,
@@ -192,7 +191,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     run = load_run_settings(args.config, robot)
     generations = args.generations if args.generations is not None else run.generations
     if args.kind == "standard" and args.equal_budget:
-        generations += EQUAL_BUDGET_GENERATIONS["hexapod" if robot == "hexapod" else "4ws"]
+        generations += lookup(robot).equal_budget_generations
     neat_file = Path(args.neat_config) if args.neat_config else run.neat_path()
     task_settings = MazeTaskSettings.load(args.task or run.task_path())
     settings = EvolutionSettings(
@@ -220,7 +219,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     )
     # The NEAT settings and the task's memory, before any work.
     layout = SensorLayout.load(config_dir() / task_settings.sensors)
-    n_outputs = 2 if args.kind == "evorbc" else ROBOT_PARAMETERS[robot]
+    n_outputs = 2 if args.kind == "evorbc" else lookup(robot).n_parameters
     pop_size = load_neat_config(neat_file, layout.n_inputs, n_outputs).pop_size
     check_evolution_memory(
         task_settings,

@@ -8,7 +8,8 @@ import time
 from pathlib import Path
 
 from evorbc_ros.cli_support import check_output_file
-from evorbc_ros.repertoire import ROBOT_PARAMETERS, Repertoire
+from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.robots.registry import ROBOT_NAMES, lookup
 from offline_evolution.commands.common import (
     CliError,
     add_workers_option,
@@ -27,14 +28,13 @@ def add_parsers(sub) -> None:
     """Register ``repertoire`` and ``export-csv``."""
     from offline_evolution.quality import METRICS
     from offline_evolution.repertoire.settings import ARCHIVES, VARIATIONS
-    from sim_bridge.robots import ROBOT_NAMES
 
     rep = sub.add_parser(
         "repertoire",
         help="generate a MAP-Elites repertoire of locomotion primitives",
         description="Generate a repertoire with batch MAP-Elites (paper Algorithm 1). "
-        "Settings come from config/repertoire/<family>.yaml (paper Table I) or "
-        "--config; options given here override them.",
+        "Settings come from the robot's settings file (config/repertoire/4ws.yaml or "
+        "hexapod.yaml: paper Table I) or --config; options given here override them.",
     )
     rep.add_argument("--robot", choices=ROBOT_NAMES, help="robot type (default: from config)")
     rep.add_argument("--metric", choices=tuple(METRICS), help="quality metric")
@@ -194,7 +194,7 @@ def cmd_repertoire(args: argparse.Namespace) -> int:
     settings = load_settings(config, options=given, **{k: getattr(args, k) for k in OPTIONS})
     check_repertoire_memory(
         settings,
-        ROBOT_PARAMETERS[settings.robot],
+        lookup(settings.robot).n_parameters,
         lambda key: given.get(key) or f"{config}: {key}",
     )
     with exclusive_outputs({"--out": out, "--checkpoint": args.checkpoint}):

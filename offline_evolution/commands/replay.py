@@ -11,11 +11,11 @@ import numpy as np
 
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.cli_support import check_output_file
-from evorbc_ros.config import config_dir
 from evorbc_ros.defaults import default_repertoire
 from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.robots.registry import lookup
 from offline_evolution.commands.common import CliError, at_least, count
-from sim_bridge.robots.hexapod import check_simulation, simulation_mismatch
+from sim_bridge.robots.design import check_simulation, simulation_mismatch
 
 #: How a user lets another repertoire fingerprint or sensor layout through.
 WAIVER = "--allow-mismatch"
@@ -155,8 +155,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
     elif recorded:
         settings = MazeTaskSettings.from_dict(recorded, f"{arb_path}: evolution.task")
     else:
-        family = "hexapod" if arb.robot == "hexapod" else "4ws"
-        settings = MazeTaskSettings.load(config_dir() / "tasks" / f"maze-{family}.yaml")
+        settings = MazeTaskSettings.load(lookup(arb.robot).settings_file("task"))
     if args.maze != "all":
         settings = MazeTaskSettings((args.maze,), settings.episode_time, 1, settings.sensors)
     where = args.task or (f"{arb_path}: evolution.task" if recorded else "the default task")

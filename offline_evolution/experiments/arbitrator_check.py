@@ -26,8 +26,8 @@ from scipy.stats import mannwhitneyu
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.robots.registry import lookup
 from offline_evolution.arbitrator.evolve import (
-    EQUAL_BUDGET_GENERATIONS,
     EvolutionSettings,
     arbitrator_file,
     evolve,
@@ -61,7 +61,7 @@ def run_one(robot: str, kind: str, seed: int, generations: int, runs: Path) -> d
             repertoire = generate_repertoire(load_settings(robot=robot, seed=seed))
             repertoire.save(rep_path)
     else:
-        generations += EQUAL_BUDGET_GENERATIONS["4ws"]
+        generations += lookup(robot).equal_budget_generations
     neat_file = run.neat_path()
     settings = EvolutionSettings(
         kind=kind,
@@ -111,9 +111,10 @@ def summarise(robots, seeds, generations, runs: Path, out: Path) -> str:
     """Aggregate the runs into a Markdown table and a fitness-curve picture per robot."""
     from offline_evolution.plots.fitness import plot_fitness_comparison
 
+    extra = " or ".join(sorted({str(lookup(r).equal_budget_generations) for r in robots}))
     lines = [
         f"Generations: {generations} for EvoRBC, {generations} + "
-        f"{EQUAL_BUDGET_GENERATIONS['4ws']} for standard NEAT (equal budget); seeds "
+        f"{extra} for standard NEAT (equal budget); seeds "
         f"{', '.join(map(str, seeds))}.",
         "",
         "| robot | method | best fitness (mean ± sd) | runs whose best genome reached all 5 "

@@ -36,7 +36,8 @@ from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.config import build_settings
 from evorbc_ros.repertoire import Repertoire, RepertoireError
-from offline_evolution.arbitrator.evolve import EQUAL_BUDGET_GENERATIONS
+from evorbc_ros.robots.hexapod import HEXAPOD
+from evorbc_ros.robots.registry import lookup
 from offline_evolution.checkpoint import CheckpointError, load_json_checkpoint
 from offline_evolution.repertoire.stats import repertoire_stats
 
@@ -195,7 +196,7 @@ def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: lis
             "reached the goal" if w["reached"] else f"{100 * w['progress']:.0f} % of the way"
             for w in walks
         )
-        base = std[0]["generations"] - EQUAL_BUDGET_GENERATIONS["hexapod"]
+        base = std[0]["generations"] - lookup(HEXAPOD).equal_budget_generations
         at_base = (
             # what standard NEAT had after as many generations as EvoRBC ran
             f" ({np.mean([e['history'][base - 1]['best_so_far'] for e in std]):.2f} at "
@@ -287,7 +288,7 @@ def _progress(path: Path) -> str | None:
         f"generation {len(best)} of {total}, best fitness so far {best[-1]:.2f} "
         f"(generation {int(np.argmax(best)) + 1}), goal {'reached' if reached else 'not reached'}"
     )
-    base = total - EQUAL_BUDGET_GENERATIONS["hexapod"]
+    base = total - lookup(HEXAPOD).equal_budget_generations
     if 0 < base <= len(best):
         text += f"; {best[base - 1]:.2f} at generation {base} (EvoRBC's budget)"
     return text

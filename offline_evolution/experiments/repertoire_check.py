@@ -18,10 +18,11 @@ import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.robots.four_ws import ROBOT_TYPES
 from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
 
-ROBOTS = ("2ws-2", "2ws-3", "4ws-3", "4ws-5")
+ROBOTS = tuple(ROBOT_TYPES)  # the paper's four 4WS types (Fig. 6 and 8)
 
 
 def occupied_cells(r: Repertoire) -> set[tuple[int, int]]:

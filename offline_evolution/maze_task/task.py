@@ -309,13 +309,14 @@ class MazeTask:
 
 
 def make_task(settings: MazeTaskSettings, robot: str, workers: int | None = None):
-    """The maze task for ``robot``: :class:`MazeTask` (4WS) or the hexapod's.
+    """The maze task for ``robot``: its registration's ``task`` factory.
 
     Args:
         workers: processes that run episodes (PyBullet robots; default: every core).
-    """
-    if robot == "hexapod":
-        from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
 
-        return HexapodMazeTask(settings, workers=workers)
-    return MazeTask(settings, robot)
+    Raises:
+        evorbc_ros.robots.registry.UnknownRobot: naming the known robots.
+    """
+    from evorbc_ros.robots.registry import lookup
+
+    return lookup(robot).make_task(settings, workers)

@@ -1,7 +1,8 @@
 """Settings of a MAP-Elites repertoire run (paper Algorithm 1 and Table I).
 
-The defaults for each robot family live in ``config/repertoire/<family>.yaml``; the CLI
-loads that file and applies command-line overrides on top.
+Each robot's defaults live in the repertoire settings file its registration names
+(``config/repertoire/4ws.yaml`` for the 4WS robots); the CLI loads that file and applies
+command-line overrides on top.
 """
 
 from __future__ import annotations
@@ -16,12 +17,11 @@ from pathlib import Path
 from evorbc_ros.config import (
     ConfigError,
     build_settings,
-    config_dir,
     load_yaml_mapping,
     setting,
 )
+from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES, lookup
 from offline_evolution.quality import METRICS
-from sim_bridge.robots import ROBOT_NAMES
 
 ARCHIVES = ("grid", "cvt")
 VARIATIONS = ("paper", "iso_line_dd")
@@ -60,14 +60,13 @@ class MapElitesSettings:
         return dataclasses.asdict(self)
 
 
-def robot_family(robot: str) -> str:
-    """Name of the settings file family for ``robot`` (``4ws`` or ``hexapod``)."""
-    return "hexapod" if robot == "hexapod" else "4ws"
-
-
 def default_settings_file(robot: str) -> Path:
-    """The shipped settings file for ``robot``'s family."""
-    return config_dir() / "repertoire" / f"{robot_family(robot)}.yaml"
+    """The repertoire settings file ``robot``'s registration names.
+
+    Raises:
+        evorbc_ros.robots.registry.UnknownRobot: naming the known robots.
+    """
+    return lookup(robot).settings_file("repertoire")
 
 
 class SettingError(ConfigError):
@@ -98,8 +97,8 @@ def blame(error: SettingError, path: str | os.PathLike, options: Mapping[str, st
 
 
 def settings_path(path: str | os.PathLike | None, robot: str | None) -> Path:
-    """The settings file a run reads: ``path``, or the shipped file of ``robot``'s family."""
-    return Path(path) if path is not None else default_settings_file(robot or "4ws-5")
+    """The settings file a run reads: ``path``, or ``robot``'s default settings file."""
+    return Path(path) if path is not None else default_settings_file(robot or DEFAULT_ROBOT)
 
 
 def load_settings(
@@ -109,7 +108,7 @@ def load_settings(
 ) -> MapElitesSettings:
     """Settings from a YAML file with ``overrides`` (``None`` values are ignored) on top.
 
-    Without ``path`` the shipped file of the robot family is used; the robot comes from
+    Without ``path`` the robot's default settings file is used; the robot comes from
     ``overrides`` or the file.
 
     Args:

@@ -52,7 +52,7 @@ def write_report(study: Study, results: Path, out: Path, replay_runs: int | None
 
 def _draw(study: Study, settings, keys, out: Path, replay_runs) -> list[tuple[str, str]]:
     """Draw the figures; returns ``(caption, file name)`` pairs."""
-    from offline_evolution.arbitrator.evolve import EQUAL_BUDGET_GENERATIONS
+    from evorbc_ros.robots.registry import DEFAULT_ROBOT, lookup
 
     wanted = study.figures or DEFAULT_FIGURES
     drawn = []
@@ -60,10 +60,14 @@ def _draw(study: Study, settings, keys, out: Path, replay_runs) -> list[tuple[st
     if "curves" in wanted:
         panel, lines = _curve_layout(keys)
         shift = None
-        if "approach" in keys:
-            robots = {s.values.get("robot") for s in settings}
-            family = "hexapod" if robots == {"hexapod"} else "4ws"
-            shift = {"evorbc": EQUAL_BUDGET_GENERATIONS[family]}
+        # Shifted only when every robot's repertoire costs as many generations: with
+        # several costs, one shift would be wrong for some curves.
+        budgets = {
+            lookup(s.values.get("robot") or DEFAULT_ROBOT).equal_budget_generations
+            for s in settings
+        }
+        if "approach" in keys and len(budgets) == 1:
+            shift = {"evorbc": budgets.pop()}
         path = out / f"{name}-fitness.png"
         figures.fitness_curves(settings, panel, lines, path, shift, study.title)
         what = "Highest fitness so far, mean over runs with the min-max band"

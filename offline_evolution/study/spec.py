@@ -254,9 +254,9 @@ def check_value(key: str, value, where: str) -> None:
         ConfigError: ``where`` and what was expected.
     """
     from evorbc_ros.mapping import MAPPINGS
+    from evorbc_ros.robots.registry import ROBOT_NAMES
     from offline_evolution.quality import METRICS
     from offline_evolution.repertoire.settings import ARCHIVES, VARIATIONS
-    from sim_bridge.robots import ROBOT_NAMES
 
     choices = {
         "approach": APPROACHES,

@@ -41,3 +41,14 @@ class FourWSRobot:
         commands = np.ascontiguousarray(self.type.commands(genes, self.geometry))
         out = run_primitives(commands, steps, self.limits)
         return PrimitiveOutcome(x=out[:, 0], y=out[:, 1], heading=out[:, 2], path=out[:, 3])
+
+
+def simulated_robot(robot, workers: int | None = None) -> FourWSRobot:
+    """A 4WS registration's simulated robot (its ``simulation`` factory).
+
+    Args:
+        robot: the :class:`~evorbc_ros.robots.registry.Robot`; its ``model`` is the type.
+        workers: unused: the compiled model runs on numba's threads.
+
+    """
+    return FourWSRobot(robot.name)

@@ -7,20 +7,18 @@ import json
 
 import numpy as np
 
-from evorbc_ros.json_files import first_difference
-from evorbc_ros.repertoire import Repertoire, RepertoireError
-from evorbc_ros.robots.hexapod import HEXAPOD, N_PARAMETERS, HexapodGeometry, parameter_specs
+from evorbc_ros.robots.hexapod import (
+    HEXAPOD,
+    N_PARAMETERS,
+    SPEED_BOUND,
+    HexapodGeometry,
+    parameter_specs,
+)
 from evorbc_ros.robots.primitive import ParameterSpec
 from sim_bridge.hexapod.evaluate import HEADING, PATH, TILT, X, Y
 from sim_bridge.hexapod.physics import PhysicsSettings
 from sim_bridge.hexapod.pool import EvaluationPool
 from sim_bridge.robots.base import PrimitiveOutcome, control_steps
-
-#: Displacement speed (m/s) no hexapod gait reaches: the archive spans this speed times T
-#: in every direction. The fastest primitives of a 200k-evaluation repertoire reach
-#: 0.51 m/s (1.01 m in 2 s, docs/hexapod.md); anything beyond the bound would be a
-#: simulation blow-up.
-SPEED_BOUND = 0.6
 
 #: Tilt (rad) beyond which an evaluation stops: eq. 6 discards the primitive anyway.
 DISCARD_TILT = np.radians(45.0)
@@ -34,33 +32,6 @@ def describe_simulation(geometry: HexapodGeometry, physics: PhysicsSettings) -> 
     """
     described = {"geometry": dataclasses.asdict(geometry), "physics": physics.as_dict()}
     return json.loads(json.dumps(described))  # as a file holds it: tuples become lists
-
-
-def simulation_mismatch(recorded: dict | None, simulation: dict | None, where: str) -> str | None:
-    """The first setting in which a file's ``recorded`` simulation differs from ``simulation``.
-
-    A file that records none (made by hand, or for the 4WS kinematics) passes: there is
-    nothing to compare.
-    """
-    if recorded is None:
-        return None
-    return first_difference({"simulation": recorded}, {"simulation": simulation}, where)
-
-
-def check_simulation(
-    repertoire: Repertoire, simulation: dict | None, source: str = "the repertoire"
-) -> None:
-    """Refuse a repertoire evolved for another simulated robot than ``simulation``.
-
-    Raises:
-        RepertoireError: one line naming ``source`` and the first setting that differs.
-
-    """
-    mismatch = simulation_mismatch(
-        repertoire.algorithm.get("simulation"), simulation, "the repertoire"
-    )
-    if mismatch:
-        raise RepertoireError(f"{source}: was evolved for a different robot ({mismatch})")
 
 
 class HexapodRobot:
@@ -116,3 +87,14 @@ class HexapodRobot:
     def close(self) -> None:
         """Stop the worker processes."""
         self.pool.close()
+
+
+def simulated_robot(robot, workers: int | None = None) -> HexapodRobot:
+    """The hexapod registration's simulated robot (its ``simulation`` factory).
+
+    Args:
+        robot: the :class:`~evorbc_ros.robots.registry.Robot`.
+        workers: PyBullet worker processes (default: every core).
+
+    """
+    return HexapodRobot(workers=workers)

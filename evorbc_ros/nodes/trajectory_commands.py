@@ -1,0 +1,68 @@
+"""The hexapod's onboard command interface: a ros2_control joint trajectory controller.
+
+Named by the hexapod registration's ``commands`` field (docs/your-robot.md). Publishes,
+reliable, ``trajectory_topic`` (trajectory_msgs/JointTrajectory): the 18 joints' targets
+(rad) for the next ``stale_timeout`` s, one point per physics step (``trajectory_rate``,
+50 Hz), see :mod:`evorbc_ros.hexapod_executor`.
+"""
+
+from __future__ import annotations
+
+from builtin_interfaces.msg import Duration
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+from evorbc_ros.hexapod_executor import HexapodExecutor, JointTargets
+from evorbc_ros.nodes.common import RELIABLE
+from evorbc_ros.robots.hexapod import JOINT_NAMES
+
+
+class JointTrajectoryCommands:
+    """The current gait as joint-target trajectories.
+
+    Args:
+        node: the ``primitive_executor`` node; its parameters ``trajectory_topic`` and
+            ``trajectory_rate`` (points per second) are used.
+        robot: the robot's registration.
+        inputs: sensor topics whose silence stops the robot.
+        stale_timeout: s, inputs older than this stop the robot (and how far ahead a
+            trajectory reaches).
+
+    """
+
+    def __init__(self, node, robot, inputs: list[str], stale_timeout: float) -> None:
+        rate = float(node.get_parameter("trajectory_rate").value)
+        self.logic = HexapodExecutor(inputs, stale_timeout, rate)
+        self.pub = node.create_publisher(
+            JointTrajectory, node.get_parameter("trajectory_topic").value, RELIABLE
+        )
+
+    def publish(self, command: JointTargets, halt: bool = False) -> None:
+        """Send one command; none before the first target, which there is nothing to hold.
+
+        Args:
+            halt: the command answers the arbitrator's "no primitive". Before any target
+                was sent there is none to hold, and an empty trajectory, ROS's "stop and
+                hold where you are" for a joint trajectory controller, is sent instead.
+
+        """
+        if len(command.positions):
+            self.pub.publish(trajectory_message(command))
+        elif halt:
+            self.pub.publish(JointTrajectory(joint_names=list(JOINT_NAMES)))
+
+
+def trajectory_message(command: JointTargets) -> JointTrajectory:
+    """A JointTrajectory with point ``k`` at ``k * dt`` s (header stamp 0: start on receipt)."""
+    msg = JointTrajectory()
+    msg.joint_names = list(JOINT_NAMES)
+    points = []
+    for k, row in enumerate(command.positions):
+        ns = round(k * command.dt * 1e9)
+        points.append(
+            JointTrajectoryPoint(
+                positions=row.tolist(),
+                time_from_start=Duration(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000),
+            )
+        )
+    msg.points = points
+    return msg

@@ -1,0 +1,1 @@
+"""The robots evorbc ships, one registration module each (see :mod:`..registry`)."""

@@ -1,0 +1,40 @@
+"""The hexapod (paper Sec. V, docs/design.md section 11), registered."""
+
+from __future__ import annotations
+
+from evorbc_ros.robots.hexapod import HEXAPOD, SPEED_BOUND, HexapodGeometry, parameter_specs
+from evorbc_ros.robots.registry import Robot, SettingsFiles
+
+ROBOTS = (
+    Robot(
+        name=HEXAPOD,
+        description="18-joint hexapod in PyBullet, 37-parameter periodic gait (eq. 10-11)",
+        parameters=parameter_specs(),
+        settings=SettingsFiles(
+            repertoire="repertoire/hexapod.yaml",
+            arbitrator="arbitrator/hexapod.yaml",
+            neat="neat/hexapod.ini",
+            task="tasks/maze-hexapod.yaml",
+        ),
+        simulation="sim_bridge.robots.hexapod:simulated_robot",
+        task="offline_evolution.maze_task.factories:hexapod_task",
+        bridge="sim_bridge.bridge_robots:HexapodBridge",
+        commands="evorbc_ros.nodes.trajectory_commands:JointTrajectoryCommands",
+        command_topics=("joint_trajectory_controller/joint_trajectory",),
+        sensors="sensors/hexapod.yaml",
+        maze="hexapod",
+        episode_time=30.0,  # s, paper Table I (hexapod)
+        footprint_radius=HexapodGeometry().footprint_radius,
+        max_speed=SPEED_BOUND,
+        # Its repertoire's simulated time in generations of 150 x 30 s episodes
+        # (paper Appendix E; docs/paper-check.md).
+        equal_budget_generations=455,
+        # Its episodes also carry their network and results between processes.
+        episode_bytes=16_000,
+        shipped_repertoire="hexapod.repertoire.json",
+        shipped_arbitrator="hexapod.arbitrator.json",
+        # The bridge simulates one design and one laser; a controller for another is
+        # refused with the first setting that differs (docs/design.md section 11).
+        design_check="sim_bridge.hexapod.design:check_controller",
+    ),
+)

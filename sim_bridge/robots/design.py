@@ -1,0 +1,40 @@
+"""A simulated robot's design as files record it, and the check that refuses another.
+
+A robot simulated with physics (the hexapod) describes its design as plain data: its
+geometry, servos and physics settings (``describe()`` of its task and simulated robot).
+Repertoires, checkpoints and arbitrator files record it, so that a file made for another
+design is refused with the first setting that differs rather than reused (docs/design.md
+section 11). A kinematic robot (4WS) records none, and nothing is compared.
+"""
+
+from __future__ import annotations
+
+from evorbc_ros.json_files import first_difference
+from evorbc_ros.repertoire import Repertoire, RepertoireError
+
+
+def simulation_mismatch(recorded: dict | None, simulation: dict | None, where: str) -> str | None:
+    """The first setting in which a file's ``recorded`` simulation differs from ``simulation``.
+
+    A file that records none (made by hand, or for the 4WS kinematics) passes: there is
+    nothing to compare.
+    """
+    if recorded is None:
+        return None
+    return first_difference({"simulation": recorded}, {"simulation": simulation}, where)
+
+
+def check_simulation(
+    repertoire: Repertoire, simulation: dict | None, source: str = "the repertoire"
+) -> None:
+    """Refuse a repertoire evolved for another simulated robot than ``simulation``.
+
+    Raises:
+        RepertoireError: one line naming ``source`` and the first setting that differs.
+
+    """
+    mismatch = simulation_mismatch(
+        repertoire.algorithm.get("simulation"), simulation, "the repertoire"
+    )
+    if mismatch:
+        raise RepertoireError(f"{source}: was evolved for a different robot ({mismatch})")

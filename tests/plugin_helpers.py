@@ -1,0 +1,132 @@
+"""A robot in its own package, built in a temporary folder as docs/your-robot.md describes.
+
+The package is the docs' example: ``evorbc_crab``, a 4WS body that steers all four wheels
+together, with its own settings files, declared through the ``evorbc.robots`` entry-point
+group in its ``pyproject.toml``. It is "installed" into a folder of its own that goes on
+``PYTHONPATH`` (and ``sys.path``), never into the venv, so no other test sees it: the
+package itself and the ``.dist-info`` folder pip would write, whose ``entry_points.txt``
+is made from the ``pyproject.toml`` (the build backend's job).
+"""
+
+import shutil
+import tomllib
+from pathlib import Path
+
+from evorbc_ros.config import config_dir
+
+PYPROJECT = """\
+[build-system]
+requires = ["setuptools>=61"]
+build-backend = "setuptools.build_meta"
+
+[project]
+name = "evorbc-crab"
+version = "0.1.0"
+description = "A four-wheel-steering robot that steers all four wheels together"
+dependencies = ["evorbc"]
+
+[project.entry-points."evorbc.robots"]
+crab = "evorbc_crab:robots"
+
+[tool.setuptools.package-data]
+evorbc_crab = ["*.yaml", "*.ini"]
+"""
+
+MODULE = '''\
+"""evorbc_crab: a 4WS body that steers all four wheels together (crab steering)."""
+
+from pathlib import Path
+
+from evorbc_ros.robots.builtin.four_ws import four_ws_robot
+from evorbc_ros.robots.four_ws import FourWSType, gene_matrix
+from evorbc_ros.robots.registry import SettingsFiles
+
+HERE = Path(__file__).resolve().parent
+
+#: Two genes: the wheel speed (command 0) and one angle for all four wheels (1 to 4).
+CRAB = FourWSType("crab", ("speed", "angle"), gene_matrix([(0,), (1, 2, 3, 4)]))
+
+
+def robots():
+    """The entry point: this package's robot registrations."""
+    return four_ws_robot(
+        CRAB,
+        "4WS body steering all four wheels together: it translates, never turns",
+        settings=SettingsFiles(
+            repertoire=str(HERE / "repertoire.yaml"),
+            arbitrator=str(HERE / "arbitrator.yaml"),
+            neat=str(HERE / "neat.ini"),
+            task=str(HERE / "task.yaml"),
+        ),
+        maze="gaps",
+        episode_time=15.0,
+        equal_budget_generations=2,
+    )
+'''
+
+#: A small budget, so the test's pipeline takes seconds.
+REPERTOIRE = """\
+robot: crab
+metric: distance          # a crab never turns: straight paths are its best primitives
+bin_size: 0.04
+eval_time: 2.0
+initial_batch: 400
+batch_size: 100
+iterations: 10
+"""
+ARBITRATOR = """\
+generations: 3
+mapping: polar
+neat: neat.ini            # beside this file
+task: task.yaml
+hall_of_fame: 4
+post_samples: 1
+"""
+TASK = """\
+mazes: [gaps]
+episode_time: 15.0
+samples_per_maze: 1
+sensors: sensors/4ws.yaml   # evorbc's (relative to its config/)
+"""
+
+
+def write_package(root: Path, module: str = MODULE) -> Path:
+    """The plugin's source tree under ``root/evorbc-crab``: pyproject, module, settings."""
+    src = root / "evorbc-crab"
+    package = src / "evorbc_crab"
+    package.mkdir(parents=True)
+    (src / "pyproject.toml").write_text(PYPROJECT)
+    (package / "__init__.py").write_text(module)
+    (package / "repertoire.yaml").write_text(REPERTOIRE)
+    (package / "arbitrator.yaml").write_text(ARBITRATOR)
+    (package / "task.yaml").write_text(TASK)
+    neat = (config_dir() / "neat" / "4ws.ini").read_text()
+    small = neat.replace("pop_size              = 150", "pop_size              = 16")
+    assert small != neat
+    (package / "neat.ini").write_text(small)
+    return src
+
+
+def install(src: Path, site: Path) -> Path:
+    """Install the package in ``src`` into ``site`` (a folder for ``PYTHONPATH``)."""
+    meta = tomllib.loads((src / "pyproject.toml").read_text())["project"]
+    site.mkdir(parents=True, exist_ok=True)
+    for package in src.iterdir():
+        if (package / "__init__.py").is_file():
+            shutil.copytree(package, site / package.name)
+    info = site / f"{meta['name'].replace('-', '_')}-{meta['version']}.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(
+        f"Metadata-Version: 2.1\nName: {meta['name']}\nVersion: {meta['version']}\n"
+    )
+    lines = []
+    for group, points in meta.get("entry-points", {}).items():
+        lines.append(f"[{group}]")
+        lines += [f"{name} = {value}" for name, value in points.items()]
+    (info / "entry_points.txt").write_text("\n".join(lines) + "\n")
+    return site
+
+
+def build_plugin(root: Path, module: str = MODULE) -> Path:
+    """Write and install the plugin; the folder to put on ``PYTHONPATH``."""
+    return install(write_package(root, module), root / "site")
