@@ -281,6 +281,27 @@ def _require(data: dict, key: str, kind, source: str, prefix: str = ""):
     return value
 
 
+def declare_robot(name: str, n_parameters: int) -> None:
+    """Let repertoires and arbitrator files in this process name ``name``, a robot of yours.
+
+    For a robot whose primitives you evaluate yourself (``MapElites``' ask/tell loop,
+    docs/design.md section 19): its repertoire then loads and saves like any other, with
+    ``n_parameters`` genes per primitive. The CLI and the nodes still drive only the
+    robots they know.
+
+    Raises:
+        ValueError: ``name`` is empty, or known with another number of parameters.
+
+    """
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"a robot needs a name, got {name!r}")
+    if isinstance(n_parameters, bool) or not isinstance(n_parameters, int) or n_parameters < 1:
+        raise ValueError(f"robot {name} needs a whole number of parameters >= 1")
+    known = ROBOT_PARAMETERS.setdefault(name, n_parameters)
+    if known != n_parameters:
+        raise ValueError(f"robot {name} is known with {known} parameters, not {n_parameters}")
+
+
 def robot_problem(robot: Any, n_parameters: int | None = None) -> str | None:
     """Why ``robot`` (with ``n_parameters`` genes, if given) is no robot we know, or None."""
     if not isinstance(robot, str) or robot not in ROBOT_PARAMETERS:
