@@ -15,12 +15,16 @@ Both implement :class:`~offline_evolution.task_protocol.ArbitratorTask`.
 
 from __future__ import annotations
 
+import abc
 import os
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
+from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.sensors import SensorLayout
 from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.maze import Maze, load_named_maze
@@ -125,8 +129,11 @@ def empty_traces(episodes: int, n_cycles: int, n_outputs: int):
     return pose, choice, outputs
 
 
-class MazeTaskBase:
+class MazeTaskBase(abc.ABC):
     """A maze task's settings, mazes, sensors, start poses and eq. 5 fitness.
+
+    A robot's maze task adds its locomotion parameters, its controllers and how its
+    episodes run (the rest of :class:`~offline_evolution.task_protocol.ArbitratorTask`).
 
     Args:
         settings: the task.
@@ -149,9 +156,19 @@ class MazeTaskBase:
         return len(self.mazes)
 
     @property
-    def parameter_specs(self) -> tuple:
+    @abc.abstractmethod
+    def parameter_specs(self) -> tuple[ParameterSpec, ...]:
         """The robot's locomotion parameters (a standard controller's outputs)."""
-        raise NotImplementedError
+
+    @abc.abstractmethod
+    def controller(
+        self, kind: str, repertoire: Repertoire | None = None, mapping: str | None = None
+    ) -> Any:
+        """An EvoRBC controller (repertoire and mapping) or a standard one."""
+
+    @abc.abstractmethod
+    def evaluate(self, networks: list, controller: Any, starts: np.ndarray, record: bool = False):
+        """Every network from every start row; episode ``i * len(starts) + j``."""
 
     @property
     def n_standard_outputs(self) -> int:
