@@ -277,15 +277,47 @@ def _require(data: dict, key: str, kind, source: str, prefix: str = ""):
     return value
 
 
+#: Robots declared by :func:`declare_robot` in this process: name -> genes per primitive.
+#: They are known to files only; the registry holds the robots the CLI and nodes drive.
+_DECLARED: dict[str, int] = {}
+
+
+def declare_robot(name: str, n_parameters: int) -> None:
+    """Let repertoires and arbitrator files in this process name ``name``, a robot of yours.
+
+    For a robot whose primitives you evaluate yourself (``MapElites``' ask/tell loop,
+    docs/design.md section 20): its repertoire then loads and saves like any other, with
+    ``n_parameters`` genes per primitive. The CLI and the nodes still drive only the
+    robots they know.
+
+    Raises:
+        ValueError: ``name`` is empty, or known with another number of parameters.
+
+    """
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"a robot needs a name, got {name!r}")
+    if isinstance(n_parameters, bool) or not isinstance(n_parameters, int) or n_parameters < 1:
+        raise ValueError(f"robot {name} needs a whole number of parameters >= 1")
+    if registry.known(name):
+        known = registry.lookup(name).n_parameters
+    else:
+        known = _DECLARED.setdefault(name, n_parameters)
+    if known != n_parameters:
+        raise ValueError(f"robot {name} is known with {known} parameters, not {n_parameters}")
+
+
 def robot_problem(robot: Any, n_parameters: int | None = None) -> str | None:
     """Why ``robot`` (with ``n_parameters`` genes, if given) is no robot we know, or None.
 
     Known robots are those of the robot registry (:mod:`evorbc_ros.robots.registry`),
     plugins included.
     """
-    if not registry.known(robot):
+    if isinstance(robot, str) and robot in _DECLARED and not registry.known(robot):
+        expected = _DECLARED[robot]
+    elif not registry.known(robot):
         return f"robot {robot!r} is not known; known robots: {', '.join(registry.names())}"
-    expected = registry.lookup(robot).n_parameters
+    else:
+        expected = registry.lookup(robot).n_parameters
     if n_parameters is not None and n_parameters != expected:
         return f"robot {robot} has {expected} parameters, the file has {n_parameters}"
     return None

@@ -1,10 +1,14 @@
-"""Arbitrator evolution (EvoRBC) and the standard-NEAT baseline on the maze task.
+"""Arbitrator evolution (EvoRBC) and the standard-NEAT baseline on any task.
 
-One generation: build each genome's network, run every genome in every maze in one batched
-kernel call (:mod:`offline_evolution.maze_task.kernel`), assign the mean eq. 5 fitness,
-then let neat-python reproduce and speciate. Start poses are new every generation and the
-same for every genome of a generation, drawn from a generator seeded by ``(seed,
-generation)``.
+One generation: build each genome's network, run every genome from every start in one
+call of the task's ``evaluate`` (the 4WS maze task: one batched kernel call,
+:mod:`offline_evolution.maze_task.kernel`), assign the mean fitness, then let neat-python
+reproduce and speciate. Start poses are new every generation and the same for every genome
+of a generation, drawn from a generator seeded by ``(seed, generation)``.
+
+The task is anything that implements :class:`~offline_evolution.task_protocol.ArbitratorTask`
+(docs/design.md section 20): by default the maze task that ``settings.task`` describes for
+``settings.robot``, or a task of the caller's own.
 
 Runs are seeded and deterministic, checkpoint every few generations as JSON (see
 :mod:`offline_evolution.arbitrator.neat_state`) and resume to exactly the result of an
@@ -52,7 +56,8 @@ from offline_evolution.checkpoint import (
     load_json_checkpoint,
     settings_mismatch,
 )
-from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings, make_task
+from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+from offline_evolution.task_protocol import ArbitratorTask
 from sim_bridge.robots.design import check_simulation
 
 CHECKPOINT_KIND = "evorbc-neat-checkpoint"
@@ -157,7 +162,17 @@ def file_sha256(path: str | os.PathLike, what: str = "NEAT settings") -> str:
 
 
 class Evolution:
-    """One NEAT run on the maze task."""
+    """One NEAT run on a task (:class:`~offline_evolution.task_protocol.ArbitratorTask`).
+
+    Args:
+        settings: the run; ``settings.task`` is recorded as it is.
+        repertoire: the repertoire an EvoRBC arbitrator chooses from.
+        workers: processes that run the maze task's episodes (PyBullet robots).
+        repertoire_source: how errors name the repertoire (its file).
+        task: the task to evolve on; by default the maze task ``settings.task`` describes
+            for ``settings.robot``. A task given here stays the caller's to close.
+
+    """
 
     def __init__(
         self,
@@ -165,9 +180,13 @@ class Evolution:
         repertoire: Repertoire | None = None,
         workers: int | None = None,
         repertoire_source: str = "the repertoire",
+        task: ArbitratorTask | None = None,
     ):
         self.settings = settings
-        self.task = make_task(MazeTaskSettings(**settings.task), settings.robot, workers)
+        self.owns_task = task is None
+        if task is None:
+            task = make_task(MazeTaskSettings(**settings.task), settings.robot, workers)
+        self.task = task
         # The simulated robot (PyBullet robots; None for the 4WS kinematics).
         self.simulation = self.task.describe()
         if settings.kind == "evorbc":
@@ -176,11 +195,11 @@ class Evolution:
             try:
                 check_simulation(repertoire, self.simulation, repertoire_source)
             except RepertoireError:
-                self.task.close()
+                self.close()
                 raise
             n_outputs = 2
         else:
-            n_outputs = self.task.n_standard_outputs
+            n_outputs = len(self.task.parameter_specs)
         self.controller = self.task.controller(settings.kind, repertoire, settings.mapping)
         self.config = load_neat_config(settings.neat_file, self.task.layout.n_inputs, n_outputs)
         self.population = neat.Population(self.config, seed=settings.seed)
@@ -190,6 +209,11 @@ class Evolution:
         self.best_reached = 0  # mazes the best genome reached in its evaluation
         self.hall = HallOfFame(settings.hall_of_fame)
         self._watched: set[int] = set()  # genome keys already run from the nominal starts
+
+    def close(self) -> None:
+        """Close the task if this run made it (a task given to it is the caller's)."""
+        if self.owns_task:
+            self.task.close()
 
     @property
     def generation(self) -> int:
@@ -202,7 +226,7 @@ class Evolution:
         return self.generation >= self.settings.generations
 
     def _evaluate(self, genomes, config) -> None:
-        """neat-python fitness function: the batched kernel over all genomes and mazes."""
+        """neat-python fitness function: every genome from every start, in one evaluate()."""
         start = time.perf_counter()
         generation = self.population.generation
         specs = [network_spec(g, config) for _, g in genomes]
@@ -281,6 +305,7 @@ class Evolution:
             [self.network(g) for g in candidates],
             starts,
             self.settings.post_rule,
+            len(self.task.nominal_starts()),
         )
         chosen = candidates[post.index]
         return EvolutionResult(
@@ -393,8 +418,9 @@ def evolve(
     workers: int | None = None,
     repertoire_source: str = "the repertoire",
     keep_checkpoint: bool = False,
+    task: ArbitratorTask | None = None,
 ) -> EvolutionResult:
-    """Run NEAT on the maze task to the last generation.
+    """Run NEAT on a task to the last generation (exported as ``evolve_arbitrator``).
 
     Args:
         settings: the run (see :class:`EvolutionSettings`).
@@ -410,12 +436,15 @@ def evolve(
         keep_checkpoint: save the finished run to ``checkpoint`` and keep it, for a caller
             that removes it only once the arbitrator file is safely written; the same
             call then only post-evaluates again (seeded: the same result).
+        task: the task to evolve on (any :class:`~offline_evolution.task_protocol.
+            ArbitratorTask`); by default the maze task ``settings.task`` describes for
+            ``settings.robot``. A task given here is left open for the caller.
 
     Raises:
         RepertoireError: the repertoire was evolved for another simulated robot.
         CheckpointError: the checkpoint exists but belongs to another run or is corrupt.
     """
-    run = Evolution(settings, repertoire, workers, repertoire_source)
+    run = Evolution(settings, repertoire, workers, repertoire_source, task)
     try:
         elapsed = 0.0
         if checkpoint is not None and os.path.exists(checkpoint):
@@ -440,12 +469,12 @@ def evolve(
             os.remove(checkpoint)
         return result
     finally:
-        run.task.close()
+        run.close()
 
 
 def arbitrator_file(
     result: EvolutionResult,
-    task: MazeTask,
+    task: ArbitratorTask,
     repertoire: Repertoire | None = None,
     repertoire_source: str | None = None,
 ) -> ArbitratorFile:

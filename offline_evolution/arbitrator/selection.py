@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:  # the task pulls in the simulation; the settings loader needs only RULES
-    from offline_evolution.maze_task.task import ControllerArrays, MazeTask
+if TYPE_CHECKING:  # a task pulls in its simulation; the settings loader needs only RULES
+    from offline_evolution.task_protocol import ArbitratorTask
 
 #: Seed stream of the post-evaluation starts, apart from every generation's.
 POST_EVALUATION_STREAM = 2**31 - 1
@@ -117,25 +117,26 @@ class PostEvaluation:
         }
 
 
-def post_evaluation_starts(task: MazeTask, seed: int, samples: int) -> np.ndarray:
-    """Each maze's nominal start plus ``samples`` seeded random starts per maze."""
+def post_evaluation_starts(task: ArbitratorTask, seed: int, samples: int) -> np.ndarray:
+    """The task's nominal starts, then ``samples`` seeded draws of its random starts."""
     rng = np.random.default_rng([seed, POST_EVALUATION_STREAM])
     rows = [task.nominal_starts()] + [task.sample_starts(rng) for _ in range(samples)]
     return np.concatenate(rows)
 
 
 def post_evaluate(
-    task: MazeTask,
-    controller: ControllerArrays,
+    task: ArbitratorTask,
+    controller,
     networks: list,
     starts: np.ndarray,
     rule: str = "mean",
+    nominal_rows: int | None = None,
 ) -> PostEvaluation:
     """Score every network on ``starts`` and pick one by ``rule`` (see :data:`RULES`).
 
-    ``starts`` begins with one nominal start per maze, as :func:`post_evaluation_starts`
-    lays them out. Ties go to the earlier candidate (the hall lists the highest training
-    fitness first).
+    ``starts`` begins with the task's ``nominal_rows`` nominal starts (by default one per
+    maze of a maze task), as :func:`post_evaluation_starts` lays them out. Ties go to the
+    earlier candidate (the hall lists the highest training fitness first).
     """
     if rule not in RULES:
         raise ValueError(f"post-evaluation rule must be one of {', '.join(RULES)}, got {rule!r}")
@@ -144,7 +145,9 @@ def post_evaluate(
     fitness = result.fitness.reshape(len(networks), n).mean(axis=1)
     reached_all = result.reached.reshape(len(networks), n).astype(bool)
     reached = reached_all.mean(axis=1)
-    nominal = reached_all[:, : len(task.mazes)].all(axis=1)
+    if nominal_rows is None:
+        nominal_rows = len(task.mazes)
+    nominal = reached_all[:, :nominal_rows].all(axis=1)
     eligible = nominal if rule == "nominal_then_mean" and nominal.any() else np.ones_like(nominal)
     k = int(np.argmax(np.where(eligible, fitness, -np.inf)))
     return PostEvaluation(

@@ -1,32 +1,32 @@
 """The maze task for the hexapod: episodes in PyBullet on worker processes (parent side).
 
-The interface is :class:`~offline_evolution.maze_task.task.MazeTask`'s: start poses,
-``evaluate`` (networks x starts -> :class:`EpisodeResult`) and eq. 5 fitness. Episodes
-are independent and start from a restored rest state, so results do not depend on the
-number of workers or on which worker ran an episode.
+Settings, mazes, start poses and eq. 5 fitness are every maze task's
+(:class:`~offline_evolution.maze_task.base.MazeTaskBase`); this module adds episodes in
+PyBullet (:mod:`~offline_evolution.maze_task.hexapod_episode`) and implements the task
+protocol (:class:`~offline_evolution.task_protocol.ArbitratorTask`). Episodes are
+independent and start from a restored rest state, so results do not depend on the number
+of workers or on which worker ran an episode.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from evorbc_ros.config import ConfigError, config_dir
+from evorbc_ros.config import ConfigError
 from evorbc_ros.network import NetworkSpec
 from evorbc_ros.repertoire import Repertoire
-from evorbc_ros.robots.hexapod import N_PARAMETERS, HexapodGeometry, parameter_specs
+from evorbc_ros.robots.hexapod import HexapodGeometry, parameter_specs
 from evorbc_ros.robots.primitive import ParameterSpec
-from evorbc_ros.sensors import SensorLayout
+from offline_evolution.maze_task.base import MazeTaskBase, MazeTaskSettings, empty_traces
 from offline_evolution.maze_task.hexapod_episode import (
     EpisodeRunner,
     HexapodController,
     HexapodWorld,
 )
-from offline_evolution.maze_task.task import EpisodeResult, MazeTaskSettings, eq5_fitness
+from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.hexapod.physics import PhysicsSettings
 from sim_bridge.hexapod.pool import SpawnedWorkers, available_cores, ignore_sigint
 from sim_bridge.hexapod.scanner import Scanner
-from sim_bridge.maze import load_named_maze
-from sim_bridge.robots.base import control_steps
 from sim_bridge.robots.hexapod import describe_simulation
 
 _runner: EpisodeRunner | None = None
@@ -47,7 +47,7 @@ def _episode(job) -> dict:
     return _run(_runner, job)
 
 
-class HexapodMazeTask(SpawnedWorkers):
+class HexapodMazeTask(MazeTaskBase, SpawnedWorkers):
     """The maze task for the hexapod (``config/tasks/maze-hexapod.yaml``)."""
 
     def __init__(
@@ -57,19 +57,15 @@ class HexapodMazeTask(SpawnedWorkers):
         geometry: HexapodGeometry | None = None,
         physics: PhysicsSettings | None = None,
     ):
-        self.settings = settings
         self.geometry = geometry or HexapodGeometry()
         self.physics = physics or PhysicsSettings()
-        self.mazes = [load_named_maze(name) for name in settings.mazes]
-        self.layout = SensorLayout.load(config_dir() / settings.sensors)
+        super().__init__(settings, self.geometry.control_period, self.geometry.footprint_radius)
         if self.layout.rangefinders is None:
             raise ConfigError(f"{settings.sensors}: the hexapod's laser needs rangefinders")
         try:  # here, not first in a worker, so that the error names the file
             Scanner.from_layout(self.layout.rangefinders)
         except ValueError as e:
             raise ConfigError(f"{settings.sensors}: {e}") from None
-        self.dt = self.geometry.control_period
-        self.n_cycles = control_steps(settings.episode_time, self.dt)
         self.world = HexapodWorld(
             tuple(self.mazes), self.layout, self.geometry, self.physics, self.n_cycles
         )
@@ -80,33 +76,9 @@ class HexapodMazeTask(SpawnedWorkers):
         return describe_simulation(self.geometry, self.physics)
 
     @property
-    def n_mazes(self) -> int:
-        """Number of mazes."""
-        return len(self.mazes)
-
-    @property
     def parameter_specs(self) -> tuple[ParameterSpec, ...]:
-        """The robot's locomotion parameters (a standard controller's outputs)."""
+        """The robot's locomotion parameters (a standard controller's outputs, 37)."""
         return parameter_specs()
-
-    @property
-    def n_standard_outputs(self) -> int:
-        """Outputs of a standard-NEAT network: one per locomotion parameter (37)."""
-        return N_PARAMETERS
-
-    def sample_starts(self, rng: np.random.Generator) -> np.ndarray:
-        """``(n_mazes * samples_per_maze, 4)`` rows ``(maze, x, y, heading)``."""
-        rows = []
-        for k, maze in enumerate(self.mazes):
-            poses = maze.sample_starts(
-                rng, self.settings.samples_per_maze, self.geometry.footprint_radius
-            )
-            rows += [(k, *p) for p in poses]
-        return np.array(rows, dtype=np.float64)
-
-    def nominal_starts(self) -> np.ndarray:
-        """One row ``(maze, x, y, heading)`` per maze at its nominal start pose."""
-        return np.array([(k, *m.start_pose) for k, m in enumerate(self.mazes)])
 
     def controller(
         self, kind: str, repertoire: Repertoire | None = None, mapping: str | None = None
@@ -136,15 +108,8 @@ class HexapodMazeTask(SpawnedWorkers):
         final = np.array([r["final_distance"] for r in results])
         initial = np.array([r["initial_distance"] for r in results])
         fell = np.array([r["fell"] for r in results], dtype=bool)
-        fitness = self.fitness(reached, cycles, final, initial)
-        if not record:
-            return EpisodeResult(reached, cycles, final, initial, fitness, fell=fell)
-        pose, choice, outputs = _padded_traces(results, self.n_cycles)
-        return EpisodeResult(reached, cycles, final, initial, fitness, pose, choice, outputs, fell)
-
-    def fitness(self, reached, cycles, final, initial) -> np.ndarray:
-        """Eq. 5 for each episode."""
-        return eq5_fitness(reached, cycles * self.dt, final, initial, self.settings.episode_time)
+        traces = _padded_traces(results, self.n_cycles) if record else None
+        return self.episode_result(reached, cycles, final, initial, traces, fell)
 
     def _map(self, jobs: list) -> list[dict]:
         if self.workers == 1 or len(jobs) == 1:
@@ -155,12 +120,9 @@ class HexapodMazeTask(SpawnedWorkers):
 
 
 def _padded_traces(results: list[dict], n_cycles: int):
-    """Per-episode traces padded like the 4WS kernel's (NaN poses, -2 choices)."""
-    n = len(results)
+    """Per-episode traces padded like the 4WS kernel's (:func:`empty_traces`)."""
     n_out = max((r["outputs"].shape[1] for r in results if r["outputs"].size), default=1)
-    pose = np.full((n, n_cycles + 1, 3), np.nan)
-    choice = np.full((n, n_cycles), -2, dtype=np.int64)
-    outputs = np.full((n, n_cycles, n_out), np.nan)
+    pose, choice, outputs = empty_traces(len(results), n_cycles, n_out)
     for e, r in enumerate(results):
         k = len(r["choice"])
         pose[e, : k + 1] = r["pose"]

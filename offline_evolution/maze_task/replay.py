@@ -9,7 +9,8 @@ import numpy as np
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.mapping import NO_PRIMITIVE
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.maze_task.task import EpisodeResult, MazeTask
+from offline_evolution.maze_task.base import MazeTaskBase
+from offline_evolution.task_protocol import EpisodeResult
 
 
 @dataclass(frozen=True)
@@ -44,11 +45,14 @@ class MazeOutcome:
 
 def replay(
     arbitrator: ArbitratorFile,
-    task: MazeTask,
+    task: MazeTaskBase,
     starts: np.ndarray,
     repertoire: Repertoire | None = None,
 ) -> tuple[list[MazeOutcome], EpisodeResult]:
-    """Run ``arbitrator`` from each ``starts`` row ``(maze, x, y, heading)``, recording."""
+    """Run ``arbitrator`` from each ``starts`` row ``(maze, x, y, heading)``, recording.
+
+    ``task`` is either maze task (the 4WS robots' or the hexapod's).
+    """
     controller = task.controller(arbitrator.kind, repertoire, arbitrator.mapping)
     result = task.evaluate([arbitrator.network], controller, starts, record=True)
     outcomes = []

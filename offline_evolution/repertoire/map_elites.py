@@ -1,22 +1,29 @@
-"""Batch MAP-Elites (paper Algorithm 1) over a simulated robot's primitives.
+"""Batch MAP-Elites (paper Algorithm 1): an ask/tell loop, and a simulated robot on top.
 
-The loop is ask -> evaluate -> add: the emitter proposes genes, the robot executes them
-for T seconds from rest, the quality metric scores the outcome, and the archive keeps the
-best primitive per cell of final displacement. Runs are seeded and deterministic; they
-checkpoint every few iterations and resume to exactly the result of an uninterrupted run.
+The loop is ask -> evaluate -> tell: the emitter proposes genes (:meth:`MapElites.ask`),
+something executes them for T seconds from rest and scores them, and the archive keeps the
+best primitive per cell of final displacement (:meth:`MapElites.tell`). The evaluation is
+the caller's, on plain arrays, as in pyribs' ``Scheduler.ask``/``tell``: a simulator of
+one's own or a real robot (docs/design.md section 20). :func:`generate_repertoire` is the
+thin layer that evaluates with the project's simulated robots and quality metrics. Runs
+are seeded and deterministic; they checkpoint every few iterations and resume to exactly
+the result of an uninterrupted run.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import ribs
 
+from evorbc_ros.config import build_settings
 from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.robots.primitive import GENE_HIGH, GENE_LOW, ParameterSpec
 from offline_evolution.checkpoint import (
     CheckpointError,
     Interrupted,
@@ -36,8 +43,8 @@ from offline_evolution.repertoire.archive import (
 from offline_evolution.repertoire.checkpoint_contents import arrays_problem, header_problem
 from offline_evolution.repertoire.emitter import IsoLineDDEmitter, PaperMutationEmitter
 from offline_evolution.repertoire.settings import MapElitesSettings, SettingError
-from sim_bridge.robots import SimulatedRobot, make_robot
-from sim_bridge.robots.base import control_steps
+from sim_bridge.robots import ROBOT_NAMES, SimulatedRobot, make_robot
+from sim_bridge.robots.base import PrimitiveOutcome, control_steps
 
 CHECKPOINT_KIND = "evorbc-map-elites-checkpoint"
 
@@ -71,33 +78,88 @@ class Progress:
 
 
 class MapElites:
-    """One MAP-Elites run: archive, emitter and the iteration counter."""
+    """One batch MAP-Elites run (paper Algorithm 1) with an ask/tell loop on plain arrays.
+
+    Its state is the archive, the emitter's generator and three counters: plain arrays
+    and JSON, which :meth:`save` writes and :meth:`restore` reads back (section 13).
+
+    With your own evaluation (your simulator, or a real robot), state the locomotion
+    parameters and the archive's reach instead of a robot, and drive the loop::
+
+        run = MapElites(settings, parameters=specs, max_reach=0.5)
+        while not run.finished:
+            genes = run.ask()                              # (n, d) in [-1, 1]
+            quality, behaviour, heading = evaluate(genes)  # yours: (n,), (n, 2) m, (n,) rad
+            run.tell(genes, quality, behaviour, heading)
+        run.repertoire().save("mine.json")
+
+    Without them, the run builds the simulated robot ``settings.robot`` names and
+    :meth:`step` is ask, the robot's evaluation and quality metric, then tell
+    (:func:`generate_repertoire` does this to the end, with checkpoints and progress).
+
+    Args:
+        settings: budget, archive, variation and seed; ``robot``, ``metric`` and
+            ``eval_time`` are recorded in the repertoire (with your own evaluation,
+            ``robot`` is your robot's name and ``metric`` names the quality you compute).
+        robot: the simulated robot; by default the one ``settings.robot`` names.
+        workers: processes that evaluate primitives (PyBullet robots).
+        parameters: your robot's locomotion parameters, one per gene (own evaluation).
+        max_reach: m, an upper bound on any primitive's displacement after
+            ``eval_time`` (own evaluation); the archive covers ``[-max_reach,
+            max_reach]^2``, widened to whole cells with one centred on the origin.
+
+    Raises:
+        SettingError: a setting does not suit the robot (eval_time), or, with your own
+            evaluation, ``parameters`` or ``max_reach`` is unusable.
+        ConfigError: with your own evaluation, a setting is out of range (as a settings
+            file's would be).
+
+    """
 
     def __init__(
         self,
         settings: MapElitesSettings,
         robot: SimulatedRobot | None = None,
         workers: int | None = None,
+        *,
+        parameters: Sequence[ParameterSpec] | None = None,
+        max_reach: float | None = None,
     ):
         self.settings = settings
-        self.robot = robot or make_robot(settings.robot, workers=workers)
-        try:
-            control_steps(settings.eval_time, self.robot.control_period)
-        except ValueError as e:
-            self.close()
-            raise SettingError("eval_time", f"{e} (robot {self.robot.name})") from None
-        self.metric = quality_metric(settings.metric)
-        reach = self.robot.max_reach(settings.eval_time)
-        if settings.archive == "cvt":
-            self.layout = cvt_layout(reach, settings.bin_size, settings.seed)
+        self.robot: SimulatedRobot | None = None
+        if parameters is not None or max_reach is not None:
+            if robot is not None:
+                raise SettingError("robot", "is not used with your own parameters and max_reach")
+            _check_own_evaluation(settings, parameters, max_reach)
+            self.parameters = tuple(parameters)
+            self.max_reach = float(max_reach)
         else:
-            self.layout = grid_layout(reach, settings.bin_size)
-        d = len(self.robot.parameter_specs)
-        self.archive = make_archive(self.layout, d, settings.seed)
+            self.robot = robot or make_robot(settings.robot, workers=workers)
+            try:
+                control_steps(settings.eval_time, self.robot.control_period)
+            except ValueError as e:
+                self.close()
+                raise SettingError("eval_time", f"{e} (robot {self.robot.name})") from None
+            self.parameters = tuple(self.robot.parameter_specs)
+            self.max_reach = self.robot.max_reach(settings.eval_time)
+        self.metric = quality_metric(settings.metric)
+        if settings.archive == "cvt":
+            self.layout = cvt_layout(self.max_reach, settings.bin_size, settings.seed)
+        else:
+            self.layout = grid_layout(self.max_reach, settings.bin_size)
+        self._low = np.asarray(self.layout["low"])
+        self._high = np.asarray(self.layout["high"])
+        self.archive = make_archive(self.layout, len(self.parameters), settings.seed)
         self.emitter = make_emitter(self.archive, settings)
         self.batches_done = 0  # pieces of the initial batch count as batches
         self.evaluations = 0
         self.discarded = 0  # primitives not added: quality NaN (fell over) or out of bounds
+        self.pending = 0  # genes asked for and not yet told
+
+    @property
+    def robot_name(self) -> str:
+        """The robot the repertoire is for (the simulated robot's, or ``settings.robot``)."""
+        return self.robot.name if self.robot is not None else self.settings.robot
 
     @property
     def iteration(self) -> int:
@@ -109,34 +171,91 @@ class MapElites:
         """True once the initial batch and every iteration have run."""
         return self.evaluations >= self.settings.evaluations
 
-    def step(self) -> None:
-        """Run one batch: ask, evaluate, then :meth:`tell`."""
-        genes = self.emitter.ask()
-        self.tell(genes, self.robot.evaluate_primitives(genes, self.settings.eval_time))
+    def ask(self) -> np.ndarray:
+        """The next batch of genes to evaluate: ``(n, d)`` in [-1, 1], one row a primitive.
 
-    def tell(self, genes: np.ndarray, outcome) -> None:
-        """Score a batch's outcome and add the primitives that count to the archive."""
-        try:
-            quality = self.metric(outcome)
-        except ValueError as e:
-            # The only metric that can refuse an outcome is circular+tilt on a robot that
-            # reports no tilt: a setting that does not suit the robot.
-            raise SettingError("metric", f"must suit robot {self.robot.name} ({e})") from None
-        behaviour = outcome.displacement
-        low, high = np.asarray(self.layout["low"]), np.asarray(self.layout["high"])
-        # NaN quality: discarded by the metric (a legged robot fell over). A behaviour
-        # outside the archive would be clipped into an edge cell: drop it instead.
-        inside = np.all((behaviour >= low) & (behaviour < high), axis=1)
+        ``n`` is at most ``settings.batch_size``: the initial batch of random genes comes
+        in pieces of that size, then each batch holds mutants of the elites. Gene ``k``
+        maps linearly onto parameter ``k``'s range (:meth:`ParameterSpec.to_physical`).
+
+        Raises:
+            RuntimeError: the previous batch was not told yet (its genes would be lost to
+                a checkpoint, and a resumed run would differ).
+
+        """
+        if self.pending:
+            raise RuntimeError(f"tell() the {self.pending} genes asked for before asking again")
+        genes = self.emitter.ask()
+        self.pending = len(genes)
+        return genes
+
+    def tell(
+        self,
+        genes: np.ndarray,
+        quality: np.ndarray | PrimitiveOutcome,
+        behaviour: np.ndarray | None = None,
+        heading: np.ndarray | None = None,
+    ) -> None:
+        """Add evaluated primitives to the archive.
+
+        A cell takes a primitive if it is empty or the quality is strictly higher than its
+        elite's. A NaN quality discards the primitive (a legged robot that fell), and so
+        does a behaviour outside the archive (it is dropped, not clipped into an edge cell).
+
+        Args:
+            genes: ``(n, d)`` in [-1, 1], usually the batch :meth:`ask` returned.
+            quality: ``(n,)``, higher is better; or the simulated robot's
+                :class:`PrimitiveOutcome`, scored with ``settings.metric``.
+            behaviour: ``(n, 2)`` m, each primitive's displacement ``(x, y)`` after
+                ``eval_time`` from rest, in its start frame (x forward, y left).
+            heading: ``(n,)`` rad, each primitive's final heading in the same frame, any
+                winding (recorded in the repertoire and drawn in its picture).
+
+        Raises:
+            ValueError: arrays of the wrong shape, genes outside [-1, 1] or not finite.
+            SettingError: the metric does not suit the robot's outcome.
+
+        """
+        if isinstance(quality, PrimitiveOutcome):
+            quality, behaviour, heading = self.score(quality)
+        elif behaviour is None or heading is None:
+            raise ValueError("tell() needs genes, quality, behaviour and heading")
+        genes, quality, behaviour, heading = _told(
+            genes, quality, behaviour, heading, len(self.parameters)
+        )
+        inside = np.all((behaviour >= self._low) & (behaviour < self._high), axis=1)
         keep = np.isfinite(quality) & inside
         self.archive.add(
             genes[keep],
             quality[keep],
             behaviour[keep],
-            heading=outcome.heading[keep],
+            heading=heading[keep],
         )
         self.batches_done += 1
         self.evaluations += len(genes)
         self.discarded += int(np.sum(~keep))
+        self.pending = 0
+
+    def score(self, outcome: PrimitiveOutcome) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(quality (n,), behaviour (n, 2) m, heading (n,) rad)`` of a robot's outcome."""
+        try:
+            quality = self.metric(outcome)
+        except ValueError as e:
+            # The only metric that can refuse an outcome is circular+tilt on a robot that
+            # reports no tilt: a setting that does not suit the robot.
+            raise SettingError("metric", f"must suit robot {self.robot_name} ({e})") from None
+        return quality, outcome.displacement, outcome.heading
+
+    def evaluate(self, genes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The simulated robot's :meth:`score` of ``genes`` ``(n, d)`` run for ``eval_time``."""
+        if self.robot is None:
+            raise RuntimeError("this run has no simulated robot: evaluate the genes yourself")
+        return self.score(self.robot.evaluate_primitives(genes, self.settings.eval_time))
+
+    def step(self) -> None:
+        """Run one batch with the simulated robot: ask, evaluate, then :meth:`tell`."""
+        genes = self.ask()
+        self.tell(genes, *self.evaluate(genes))
 
     def close(self) -> None:
         """Release the robot's resources (worker processes of a PyBullet robot)."""
@@ -163,12 +282,19 @@ class MapElites:
         )
 
     def repertoire(self) -> Repertoire:
-        """The archive as a :class:`Repertoire`, primitives ordered by cell."""
+        """The archive as a :class:`Repertoire`, primitives ordered by cell.
+
+        Raises:
+            RepertoireError: the repertoire is not valid (for instance, with your own
+                evaluation, ``settings.robot`` or ``settings.metric`` is not one evorbc
+                knows, or the parameters do not fit that robot).
+
+        """
         elites = elites_by_cell(self.archive)
         s = self.settings
         return Repertoire(
-            robot=self.robot.name,
-            parameters=self.robot.parameter_specs,
+            robot=self.robot_name,
+            parameters=self.parameters,
             genes=elites["solution"],
             behaviour=elites["measures"],
             heading=elites["heading"],
@@ -197,6 +323,7 @@ class MapElites:
                 "discarded": self.discarded,
                 "library": f"pyribs {ribs.__version__}",
                 **self._simulation(),
+                **self._own_evaluation(),
             },
         )
 
@@ -204,10 +331,23 @@ class MapElites:
         describe = getattr(self.robot, "describe", None)
         return {"simulation": describe()} if describe is not None else {}
 
+    def _own_evaluation(self) -> dict:
+        """What only a run with the caller's evaluation records (its stated reach)."""
+        if self.robot is not None:
+            return {}
+        return {"evaluation": "ask/tell by the caller", "max_reach": self.max_reach}
+
     # -- checkpoints -------------------------------------------------------------------
 
     def save(self, path: str | os.PathLike) -> None:
-        """Write a checkpoint of the finished batches."""
+        """Write a checkpoint of the finished batches (plain arrays and a JSON header).
+
+        Raises:
+            RuntimeError: genes were asked for and not told yet.
+
+        """
+        if self.pending:
+            raise RuntimeError(f"tell() the {self.pending} genes asked for before saving")
         elites = elites_by_cell(self.archive)
         header = {
             "kind": CHECKPOINT_KIND,
@@ -218,11 +358,18 @@ class MapElites:
             "emitter": self.emitter.get_state(),
             # The simulated robot (PyBullet robots): another design cannot resume this run.
             "simulation": self._simulation().get("simulation"),
+            **self._own_design(),
         }
         arrays = {k: elites[k] for k in ("solution", "objective", "measures", *EXTRA_FIELDS)}
         if "centroids" in self.layout:
             arrays["centroids"] = np.asarray(self.layout["centroids"])
         save_checkpoint(path, header, arrays)
+
+    def _own_design(self) -> dict:
+        """The parameters and reach a run with the caller's evaluation was stated with."""
+        if self.robot is not None:
+            return {}
+        return {"parameters": [p.as_dict() for p in self.parameters], "max_reach": self.max_reach}
 
     def restore(self, path: str | os.PathLike) -> None:
         """Continue from a checkpoint written by :meth:`save` for the same settings.
@@ -237,7 +384,9 @@ class MapElites:
         saved = header.get("settings")
         if not isinstance(saved, dict):
             raise CheckpointError(f"{path}: not a usable checkpoint (settings missing)")
-        mismatch = settings_mismatch(saved, self.settings.as_dict())
+        mismatch = settings_mismatch(saved, self.settings.as_dict()) or settings_mismatch(
+            {k: header.get(k) for k in self._own_design()}, self._own_design()
+        )
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
         check_same_robot(path, header.get("simulation"), self._simulation().get("simulation"))
@@ -247,9 +396,8 @@ class MapElites:
             # k-means is seeded, but a different BLAS or scikit-learn could still move
             # the centroids; elites filed under other cells would silently change the run.
             raise CheckpointError(f"{path}: its CVT centroids differ from this run's")
-        d = len(self.robot.parameter_specs)
         problem = header_problem(header, self.settings) or arrays_problem(
-            arrays, d, self.layout, header["evaluations"]
+            arrays, len(self.parameters), self.layout, header["evaluations"]
         )
         if problem is None:
             try:
@@ -277,7 +425,52 @@ class MapElites:
         self.batches_done = header["batches_done"]
         self.evaluations = header["evaluations"]
         self.discarded = header["discarded"]
+        self.pending = 0
         return None
+
+
+def _check_own_evaluation(
+    settings: MapElitesSettings, parameters: Sequence[ParameterSpec] | None, max_reach
+) -> None:
+    """Refuse parameters, a reach or settings that no run could use (one line each)."""
+    if parameters is None or max_reach is None:
+        raise SettingError("parameters", "and max_reach are both needed for your own evaluation")
+    if not parameters or not all(isinstance(p, ParameterSpec) for p in parameters):
+        raise SettingError("parameters", "must be one or more ParameterSpec, one per gene")
+    for k, p in enumerate(parameters):
+        if not (math.isfinite(p.low) and math.isfinite(p.high) and p.low < p.high):
+            raise SettingError("parameters", f"[{k}] ({p.name}) needs finite low < high")
+    if isinstance(max_reach, bool) or not isinstance(max_reach, (int, float)):
+        raise SettingError("max_reach", f"must be a number of metres, got {max_reach!r}")
+    if not (math.isfinite(max_reach) and max_reach > 0):
+        raise SettingError("max_reach", f"must be a finite number of metres > 0, got {max_reach!r}")
+    if not isinstance(settings.robot, str) or not settings.robot:
+        raise SettingError("robot", f"must name your robot, got {settings.robot!r}")
+    # Every other setting is checked as a settings file's would be; the robot is yours,
+    # so any name stands in for it in the check.
+    build_settings(
+        type(settings), {**settings.as_dict(), "robot": ROBOT_NAMES[0]}, "MapElitesSettings"
+    )
+
+
+def _told(genes, quality, behaviour, heading, d: int) -> tuple[np.ndarray, ...]:
+    """The arrays given to :meth:`MapElites.tell` as float64, checked against each other."""
+    genes = np.asarray(genes, dtype=np.float64)
+    quality = np.asarray(quality, dtype=np.float64)
+    behaviour = np.asarray(behaviour, dtype=np.float64)
+    heading = np.asarray(heading, dtype=np.float64)
+    n = len(genes)
+    expected = {"genes": (n, d), "quality": (n,), "behaviour": (n, 2), "heading": (n,)}
+    for name, array in zip(expected, (genes, quality, behaviour, heading), strict=True):
+        if array.shape != expected[name]:
+            raise ValueError(
+                f"tell(): {name} has shape {array.shape}, expected {expected[name]} "
+                f"({n} primitives, {d} parameters)"
+            )
+    # NaN fails both comparisons, so this also refuses genes that are not finite.
+    if n and not (genes.min() >= GENE_LOW and genes.max() <= GENE_HIGH):
+        raise ValueError(f"tell(): genes must be finite and lie in [{GENE_LOW}, {GENE_HIGH}]")
+    return genes, quality, behaviour, heading
 
 
 def make_emitter(archive, settings: MapElitesSettings) -> PaperMutationEmitter:

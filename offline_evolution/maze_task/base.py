@@ -1,0 +1,204 @@
+"""What every maze task shares: settings, mazes, start poses, eq. 5 fitness and traces.
+
+A controller's fitness in one episode is (paper eq. 5, docs/design.md section 4)::
+
+    2 - t / T          if the target was reached after t seconds (T = episode_time)
+    1 - d_f / d_i      otherwise (final over initial distance to the target)
+
+and its fitness for selection is the mean over the task's episodes (one per maze by
+default, new random starts each generation).
+
+:class:`MazeTaskBase` holds this; the 4WS task (:mod:`~offline_evolution.maze_task.task`)
+and the hexapod's (:mod:`~offline_evolution.maze_task.hexapod_task`) add how episodes run.
+Both implement :class:`~offline_evolution.task_protocol.ArbitratorTask`.
+"""
+
+from __future__ import annotations
+
+import abc
+import os
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
+from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.robots.primitive import ParameterSpec
+from evorbc_ros.sensors import SensorLayout
+from offline_evolution.task_protocol import EpisodeResult
+from sim_bridge.maze import Maze, load_named_maze
+from sim_bridge.robots.base import control_steps
+
+#: s between the arbitrator's decisions, for the 4WS robots and the hexapod alike.
+CONTROL_PERIOD = 0.1
+
+#: The choice a trace holds for a cycle the episode did not run (it ended before).
+NOT_RUN = -2
+
+
+@dataclass(frozen=True)
+class MazeTaskSettings:
+    """What defines the task (``config/tasks/*.yaml``)."""
+
+    mazes: tuple[str, ...] = setting(doc="maze names or files")
+    episode_time: float = setting(120.0, doc="episode length T (s)", minimum=0.1)
+    samples_per_maze: int = setting(1, doc="random starts per maze per evaluation", minimum=1)
+    sensors: str = setting("sensors/4ws.yaml", doc="sensor layout file, relative to config/")
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> MazeTaskSettings:
+        """Settings from a task file (``config/tasks/*.yaml``).
+
+        Raises:
+            ConfigError: naming the file and the key, for any bad setting (see
+                :meth:`from_dict`).
+        """
+        return cls.from_dict(load_yaml_mapping(path), str(path))
+
+    @classmethod
+    def from_dict(cls, values: dict, source: str) -> MazeTaskSettings:
+        """Settings from a mapping: a task file's, or the one an arbitrator file records.
+
+        Raises:
+            ConfigError: naming ``source`` and the key, for any bad setting; episode_time
+                must be a whole number of the 0.1 s control cycles that every robot
+                family here uses (paper Sec. III-C), and every maze and the sensor
+                layout must load.
+        """
+        if not isinstance(values, dict):
+            raise ConfigError(f"{source}: expected a mapping of task settings")
+        settings = build_settings(cls, values, source)
+        try:
+            control_steps(settings.episode_time, CONTROL_PERIOD)
+        except ValueError as e:
+            raise ConfigError(f"{source}: episode_time {e}") from None
+        if not settings.mazes:
+            raise ConfigError(f"{source}: mazes must name at least one maze")
+        # The files the task refers to, checked here so that an error names this source.
+        for name in settings.mazes:
+            try:
+                load_named_maze(name)
+            except ConfigError as e:
+                raise ConfigError(f"{source}: mazes: {e}") from None
+        layout = config_dir() / settings.sensors
+        if not layout.is_file():
+            raise ConfigError(
+                f"{source}: sensors: no such file {layout} (the path is relative to config/)"
+            )
+        try:
+            SensorLayout.load(layout)
+        except ConfigError as e:
+            raise ConfigError(f"{source}: sensors: {e}") from None
+        return settings
+
+    def as_dict(self) -> dict:
+        """Plain-data form (recorded in arbitrator files)."""
+        return {
+            "mazes": list(self.mazes),
+            "episode_time": self.episode_time,
+            "samples_per_maze": self.samples_per_maze,
+            "sensors": self.sensors,
+        }
+
+
+def eq5_fitness(reached, seconds, final, initial, episode_time: float) -> np.ndarray:
+    """Eq. 5 per episode: ``2 - t/T`` if reached after ``t`` s, else ``1 - d_f / d_i``.
+
+    Args:
+        reached: ``(E,)`` bool; seconds: ``(E,)`` s until the target (or the whole
+            episode); final, initial: ``(E,)`` m to the target; episode_time: T, s.
+
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        missed = np.where(initial > 0, 1.0 - final / initial, 0.0)
+    return np.where(reached, 2.0 - np.asarray(seconds) / episode_time, missed)
+
+
+def empty_traces(episodes: int, n_cycles: int, n_outputs: int):
+    """``(pose, choice, outputs)`` for ``episodes`` recorded episodes, no cycle run yet.
+
+    Returns:
+        ``pose (E, n_cycles + 1, 3)`` and ``outputs (E, n_cycles, n_outputs)`` of NaN,
+        ``choice (E, n_cycles)`` of :data:`NOT_RUN`; an episode fills the cycles it runs.
+
+    """
+    pose = np.full((episodes, n_cycles + 1, 3), np.nan)
+    choice = np.full((episodes, n_cycles), NOT_RUN, dtype=np.int64)
+    outputs = np.full((episodes, n_cycles, n_outputs), np.nan)
+    return pose, choice, outputs
+
+
+class MazeTaskBase(abc.ABC):
+    """A maze task's settings, mazes, sensors, start poses and eq. 5 fitness.
+
+    A robot's maze task adds its locomotion parameters, its controllers and how its
+    episodes run (the rest of :class:`~offline_evolution.task_protocol.ArbitratorTask`).
+
+    Args:
+        settings: the task.
+        dt: s, the robot's control period.
+        footprint_radius: m, how far a random start keeps the robot's centre from walls.
+
+    """
+
+    def __init__(self, settings: MazeTaskSettings, dt: float, footprint_radius: float):
+        self.settings = settings
+        self.mazes: list[Maze] = [load_named_maze(name) for name in settings.mazes]
+        self.layout = SensorLayout.load(config_dir() / settings.sensors)
+        self.dt = dt
+        self.n_cycles = control_steps(settings.episode_time, dt)
+        self.footprint_radius = footprint_radius
+
+    @property
+    def n_mazes(self) -> int:
+        """Number of mazes."""
+        return len(self.mazes)
+
+    @property
+    @abc.abstractmethod
+    def parameter_specs(self) -> tuple[ParameterSpec, ...]:
+        """The robot's locomotion parameters (a standard controller's outputs)."""
+
+    @abc.abstractmethod
+    def controller(
+        self, kind: str, repertoire: Repertoire | None = None, mapping: str | None = None
+    ) -> Any:
+        """An EvoRBC controller (repertoire and mapping) or a standard one."""
+
+    @abc.abstractmethod
+    def evaluate(self, networks: list, controller: Any, starts: np.ndarray, record: bool = False):
+        """Every network from every start row; episode ``i * len(starts) + j``."""
+
+    @property
+    def n_standard_outputs(self) -> int:
+        """Outputs of a standard-NEAT network: one per locomotion parameter."""
+        return len(self.parameter_specs)
+
+    def sample_starts(self, rng: np.random.Generator) -> np.ndarray:
+        """``(n_mazes * samples_per_maze, 4)`` rows ``(maze, x, y, heading)``."""
+        rows = []
+        for k, maze in enumerate(self.mazes):
+            poses = maze.sample_starts(rng, self.settings.samples_per_maze, self.footprint_radius)
+            rows += [(k, *p) for p in poses]
+        return np.array(rows, dtype=np.float64)
+
+    def nominal_starts(self) -> np.ndarray:
+        """One row ``(maze, x, y, heading)`` per maze at its nominal start pose."""
+        return np.array([(k, *m.start_pose) for k, m in enumerate(self.mazes)])
+
+    def fitness(self, reached, cycles, final, initial) -> np.ndarray:
+        """Eq. 5 for each episode."""
+        return eq5_fitness(reached, cycles * self.dt, final, initial, self.settings.episode_time)
+
+    def episode_result(
+        self, reached, cycles, final, initial, traces=None, fell=None
+    ) -> EpisodeResult:
+        """An :class:`EpisodeResult` with eq. 5 fitness; ``traces``: ``(pose, choice, outputs)``."""
+        pose, choice, outputs = traces if traces is not None else (None, None, None)
+        fitness = self.fitness(reached, cycles, final, initial)
+        return EpisodeResult(reached, cycles, final, initial, fitness, pose, choice, outputs, fell)
+
+    def describe(self) -> dict | None:
+        """No simulated design to record (a kinematic robot); PyBullet tasks override it."""
+        return None
