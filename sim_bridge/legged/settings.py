@@ -209,8 +209,21 @@ def load_robot_settings(path: str | Path) -> LeggedRobotSettings:
 
     """
     path = Path(path)
+    return robot_settings_from_mapping(load_yaml_mapping(path), path)
+
+
+def robot_settings_from_mapping(data: dict, path: str | Path) -> LeggedRobotSettings:
+    """The legged robot described by ``data``, a settings file's mapping read from ``path``.
+
+    ``path`` names the file in messages and anchors a relative ``urdf``; benchmarks that
+    compare designs change ``data`` before building the robot.
+
+    Raises:
+        ConfigError: one line naming the file and the key that is wrong.
+
+    """
+    path = Path(path)
     source = str(path)
-    data = load_yaml_mapping(path)
     # The typed keys first: an unknown or missing key is named before anything else.
     for key in _SECTIONS[:-1]:
         if key not in data:
