@@ -29,11 +29,22 @@ arbitrator switches.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+# RHO_LOW, RHO_HIGH and gait_step_times are the hexapod's as well as every legged robot's.
+from evorbc_ros.robots.legged import (  # noqa: F401
+    RHO_HIGH,
+    RHO_LOW,
+    Gait,
+    JointDrive,
+    LeggedGaitTable,
+    Oscillator,
+    gait_step_times,
+)
 from evorbc_ros.robots.primitive import ParameterSpec
 
 #: Robot name used in files, settings and on the command line.
@@ -47,8 +58,6 @@ LEG_JOINTS = ("coxa", "femur", "tibia")
 JOINT_NAMES = tuple(f"{leg}_{joint}" for leg in LEG_NAMES for joint in LEG_JOINTS)
 #: Evolved joints (A1, B1, ..., A6, B6): indices into :data:`JOINT_NAMES`.
 EVOLVED_JOINTS = tuple(3 * leg + k for leg in range(6) for k in (0, 1))
-#: Smoothness rho of eq. 10: pi/8 (close to a sine) to pi/8 + 2 pi (close to a square).
-RHO_LOW, RHO_HIGH = math.pi / 8.0, math.pi / 8.0 + 2.0 * math.pi
 #: Number of primitive parameters: rho plus (offset, amplitude, phase) for 12 joints.
 N_PARAMETERS = 1 + 3 * len(EVOLVED_JOINTS)
 
@@ -150,20 +159,38 @@ class HexapodGeometry:
         return q
 
 
+@functools.lru_cache(maxsize=8)
+def hexapod_gait(geometry: HexapodGeometry | None = None) -> Gait:
+    """The hexapod as a legged robot's gait (:mod:`evorbc_ros.robots.legged`).
+
+    Oscillators ``A1, B1, ..., A6, B6`` (named after the joints they drive) over
+    ``[-limit, limit]``; each drives its joint, and ``C = 90 deg - B`` keeps the shin
+    vertical. Left and right legs mirror each other with the same signs (module docstring).
+    ``config/robots/hexapod.yaml`` describes the same gait (a test keeps them equal).
+    """
+    g = geometry or HexapodGeometry()
+    limits = (g.coxa_limit, g.femur_limit)
+    oscillators, joints = [], []
+    for k, leg in enumerate(LEG_NAMES):
+        mirror_leg = LEG_NAMES[(k + 3) % 6]
+        for i in (0, 1):
+            name, mirror = f"{leg}_{LEG_JOINTS[i]}", f"{mirror_leg}_{LEG_JOINTS[i]}"
+            oscillators.append(Oscillator(name, -limits[i], limits[i], mirror, 1.0))
+        a, b = 2 * k, 2 * k + 1
+        joints += [
+            JointDrive(f"{leg}_coxa", 0.0, ((a, 1.0),)),
+            JointDrive(f"{leg}_femur", 0.0, ((b, 1.0),)),
+            JointDrive(f"{leg}_tibia", 0.5 * math.pi, ((b, -1.0),)),
+        ]
+    return Gait(tuple(oscillators), tuple(joints), g.frequency)
+
+
 def parameter_specs() -> tuple[ParameterSpec, ...]:
     """Names, units and ranges of the 37 parameters (paper eq. 11), genes in [-1, 1]."""
-    specs = [ParameterSpec("rho", "1", RHO_LOW, RHO_HIGH)]
-    for index in EVOLVED_JOINTS:
-        joint = JOINT_NAMES[index]
-        specs += [
-            ParameterSpec(f"{joint}.offset", "joint range", -1.0, 1.0),
-            ParameterSpec(f"{joint}.amplitude", "joint range", 0.0, 1.0),
-            ParameterSpec(f"{joint}.phase", "cycle", 0.0, 1.0),
-        ]
-    return tuple(specs)
+    return hexapod_gait().parameter_specs()
 
 
-class GaitTable:
+class GaitTable(LeggedGaitTable):
     """Primitives in physical units, ready to give joint targets at any time.
 
     Args:
@@ -173,60 +200,13 @@ class GaitTable:
     """
 
     def __init__(self, genes: np.ndarray, geometry: HexapodGeometry | None = None):
-        g = np.clip(np.atleast_2d(np.asarray(genes, dtype=np.float64)), -1.0, 1.0)
-        if g.shape[1] != N_PARAMETERS:
-            raise ValueError(f"hexapod primitives have {N_PARAMETERS} genes, got {g.shape[1]}")
         self.geometry = geometry or HexapodGeometry()
-        unit = 0.5 * (g + 1.0)  # [-1, 1] -> [0, 1]
-        self.rho = RHO_LOW + unit[:, 0] * (RHO_HIGH - RHO_LOW)  # (n,)
-        self.offset = g[:, 1::3]  # (n, 12) joint-range units
-        self.amplitude = unit[:, 2::3]  # (n, 12)
-        self.phase = unit[:, 3::3]  # (n, 12) cycles
-        self.limits = self.geometry.evolved_limits()
-
-    def __len__(self) -> int:
-        return len(self.rho)
-
-    def evolved_targets(self, t: float | np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
-        """Eq. 10 targets (rad) of the 12 evolved joints at time ``t`` (s).
-
-        Args:
-            t: scalar, or ``(m,)`` times (one per selected row).
-            rows: which primitives (default: all).
-
-        Returns:
-            ``(m, 12)`` rad.
-
-        """
-        sel = slice(None) if rows is None else rows
-        t = np.asarray(t, dtype=np.float64)
-        t_col = t[:, None] if t.ndim else t
-        wave = np.sin(2.0 * math.pi * (t_col * self.geometry.frequency + self.phase[sel]))
-        p = self.offset[sel] + self.amplitude[sel] * np.tanh(self.rho[sel][:, None] * wave)
-        return np.clip(p, -1.0, 1.0) * self.limits
-
-    def joint_targets(self, t: float | np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
-        """All 18 joint targets (rad) at time ``t`` (s), ``C = -B + 90 deg``; ``(m, 18)``."""
-        return full_pose(self.evolved_targets(t, rows))
-
-
-def gait_step_times(first_step: int, steps: int, dt: float) -> np.ndarray:
-    """Gait times (s) of physics steps ``first_step, first_step + 1, ...``: ``n * dt``.
-
-    The simulation and the onboard executor both count whole steps since the gait began
-    and multiply once, so they sample eq. 10 at bit-identical times.
-    """
-    return (first_step + np.arange(steps)) * dt
+        super().__init__(genes, hexapod_gait(self.geometry), HEXAPOD)
 
 
 def full_pose(evolved: np.ndarray) -> np.ndarray:
     """``(m, 18)`` joint targets from ``(m, 12)`` A/B targets: each shin kept vertical."""
-    evolved = np.atleast_2d(evolved)
-    q = np.empty((evolved.shape[0], 18))
-    q[:, 0::3] = evolved[:, 0::2]
-    q[:, 1::3] = evolved[:, 1::2]
-    q[:, 2::3] = 0.5 * math.pi - evolved[:, 1::2]
-    return q
+    return hexapod_gait().drive(evolved)
 
 
 def mirror_genes(genes: np.ndarray) -> np.ndarray:
@@ -236,7 +216,4 @@ def mirror_genes(genes: np.ndarray) -> np.ndarray:
     mirrored robot runs the mirrored gait and its displacement ``(x, y)`` becomes
     ``(x, -y)``, its heading ``-heading``.
     """
-    g = np.array(genes, dtype=np.float64, copy=True)
-    joints = g[..., 1:].reshape(*g.shape[:-1], 6, 6)  # (..., leg, A/B x offset/amp/phase)
-    g[..., 1:] = joints[..., [3, 4, 5, 0, 1, 2], :].reshape(*g.shape[:-1], 36)
-    return g
+    return hexapod_gait().mirror_genes(genes)

@@ -1,101 +1,22 @@
-"""Hexapod primitive evaluations spread over worker processes, one PyBullet client each.
+"""Hexapod primitive evaluations spread over worker processes: the legged robot's pool.
 
-Every primitive starts from the same saved rest state and Bullet is deterministic with
-``deterministicOverlappingPairs=1``, so an evaluation's outcome does not depend on which
-worker ran it or what ran before: results are identical for any number of workers.
-
-Workers are started with ``spawn`` (PyBullet clients and numba's threads do not survive a
-fork) and ignore SIGINT, so Ctrl-C reaches only the parent, which decides whether to stop
-after the current batch.
+:mod:`sim_bridge.legged.pool` holds the code; the names stay importable from here.
 """
 
 from __future__ import annotations
 
-import multiprocessing
-import os
-import signal
-from concurrent.futures import ProcessPoolExecutor
-
-import numpy as np
+import functools
 
 from evorbc_ros.robots.hexapod import HexapodGeometry
-from sim_bridge.hexapod.evaluate import evaluate_genes
 from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings
+from sim_bridge.legged import pool as _legged
+from sim_bridge.legged.pool import CHUNK, SpawnedWorkers, available_cores, ignore_sigint
 
-#: Primitives per task sent to a worker: large enough that the round trip (~1 ms) is
-#: small against ~30 ms per primitive, small enough to balance primitives that stop early.
-CHUNK = 20
-
-_worker_sim: HexapodSim | None = None
+__all__ = ["CHUNK", "EvaluationPool", "SpawnedWorkers", "available_cores", "ignore_sigint"]
 
 
-def _init_worker(geometry: HexapodGeometry, physics: PhysicsSettings) -> None:
-    global _worker_sim
-    ignore_sigint()
-    _worker_sim = HexapodSim(geometry, physics)
-
-
-def _work(args) -> np.ndarray:
-    genes, eval_time, control_period, max_tilt = args
-    return evaluate_genes(_worker_sim, genes, eval_time, control_period, max_tilt)
-
-
-def available_cores() -> int:
-    """CPU cores this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not Linux
-        return os.cpu_count() or 1
-
-
-class SpawnedWorkers:
-    """A lazily started ``spawn`` process pool plus an optional in-process fallback.
-
-    Subclasses set ``workers`` and ``_local`` (anything with ``close()``) and call
-    :meth:`_pool` to get the executor the first time work is spread out.
-    """
-
-    workers: int = 1
-    _executor: ProcessPoolExecutor | None = None
-    _local = None
-
-    def _pool(self, initializer, initargs: tuple) -> ProcessPoolExecutor:
-        """The executor, started on first use with ``initializer(*initargs)`` per worker."""
-        if self._executor is None:
-            self._executor = ProcessPoolExecutor(
-                self.workers,
-                mp_context=multiprocessing.get_context("spawn"),
-                initializer=initializer,
-                initargs=initargs,
-            )
-        return self._executor
-
-    def close(self) -> None:
-        """Stop the workers and the in-process simulation."""
-        if self._executor is not None:
-            self._executor.shutdown(wait=True, cancel_futures=True)
-            self._executor = None
-        if self._local is not None:
-            self._local.close()
-            self._local = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
-
-
-def ignore_sigint() -> None:
-    """Worker initialiser step: Ctrl-C is the parent's to handle, between batches."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-class EvaluationPool(SpawnedWorkers):
-    """Evaluates batches of primitives on ``workers`` processes (1: in this process).
-
-    Use as a context manager, or call :meth:`close`.
-    """
+class EvaluationPool(_legged.EvaluationPool):
+    """Evaluates batches of hexapod primitives on ``workers`` processes (1: in this one)."""
 
     def __init__(
         self,
@@ -105,22 +26,4 @@ class EvaluationPool(SpawnedWorkers):
     ) -> None:
         self.geometry = geometry
         self.physics = physics
-        self.workers = max(1, workers or available_cores())
-
-    def evaluate(
-        self, genes: np.ndarray, eval_time: float, control_period: float, max_tilt: float
-    ) -> np.ndarray:
-        """Outcome rows of :func:`~sim_bridge.hexapod.evaluate.evaluate_genes`, in order."""
-        genes = np.atleast_2d(np.asarray(genes, dtype=np.float64))
-        if len(genes) == 0:
-            return np.empty((0, 6))
-        if self.workers == 1:
-            if self._local is None:
-                self._local = HexapodSim(self.geometry, self.physics)
-            return evaluate_genes(self._local, genes, eval_time, control_period, max_tilt)
-        executor = self._pool(_init_worker, (self.geometry, self.physics))
-        chunks = [
-            (genes[i : i + CHUNK], eval_time, control_period, max_tilt)
-            for i in range(0, len(genes), CHUNK)
-        ]
-        return np.concatenate(list(executor.map(_work, chunks)))
+        super().__init__(functools.partial(HexapodSim, geometry, physics), workers)

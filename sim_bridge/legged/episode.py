@@ -1,0 +1,221 @@
+"""One legged robot's maze episode in PyBullet, with the onboard controller code.
+
+Each control cycle (0.1 s): scan the laser and read the pose, turn them into inputs with
+the laser and radar nodes' own code (:class:`~evorbc_ros.laser.LaserToRangefinders`,
+:class:`~evorbc_ros.goal.GoalInputs`), activate the network
+(:class:`~evorbc_ros.network.CompiledNetwork`), pick the primitive (EvoRBC: mapping and
+nearest-primitive lookup; standard NEAT: the outputs are the genes), and run the
+physics for one period with the joint targets of eq. 10 at every physics step (time since
+the gait began). The episode ends at the target, when the body has fallen over, or at
+the time limit.
+
+A cycle whose network outputs are not finite runs no primitive, as onboard (the
+arbitrator's empty message, :mod:`evorbc_ros.hexapod_executor`): every joint holds the
+target being tracked, that is the last primitive's target at the cycle's first step, or
+the joints' start positions before any primitive. The gait clock starts with the first
+primitive, as the executor's does.
+
+The ROS graph computes the same numbers from the same messages, so a lockstep run
+reproduces an episode cycle by cycle. This is the hexapod's episode
+(:mod:`offline_evolution.maze_task.hexapod_episode`) for any legged robot; a test keeps
+the two bit-identical on the hexapod.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from evorbc_ros.goal import GoalInputs, yaw_from_quaternion
+from evorbc_ros.laser import LaserToRangefinders
+from evorbc_ros.mapping import NO_PRIMITIVE, MappingFunction, PrimitiveLookup, choose_primitive
+from evorbc_ros.network import NetworkSpec
+from evorbc_ros.robots.legged import LeggedGaitTable, gait_step_times
+from evorbc_ros.sensors import SensorLayout
+from sim_bridge.legged.physics import LeggedSim
+from sim_bridge.legged.scanner import Scanner
+from sim_bridge.legged.settings import LeggedRobotSettings
+from sim_bridge.maze import Maze
+
+
+@dataclass(frozen=True)
+class LeggedController:
+    """How network outputs become a primitive (picklable, sent to the workers)."""
+
+    kind: str  # "evorbc" or "standard"
+    mapping: str | None = None
+    genes: np.ndarray | None = None  # (n, 1 + 3 k) repertoire genes (EvoRBC)
+    behaviour: np.ndarray | None = None  # (n, 2) m, repertoire behaviours (EvoRBC)
+    key: str = ""  # identifies the controller, so workers build its lookup grid once
+
+
+@dataclass(frozen=True)
+class LeggedWorld:
+    """Everything an episode needs besides the controller (picklable)."""
+
+    mazes: tuple[Maze, ...]
+    layout: SensorLayout
+    settings: LeggedRobotSettings
+    n_cycles: int
+
+    def scanner(self) -> Scanner:
+        """The laser scanner whose beams are the layout's rays."""
+        return Scanner.from_layout(self.layout.rangefinders)
+
+
+class _Chooser:
+    """Network outputs -> genes, as the arbitrator or a standard controller does."""
+
+    def __init__(self, controller: LeggedController, settings: LeggedRobotSettings):
+        self.kind = controller.kind
+        if self.kind == "evorbc":
+            self.genes = np.asarray(controller.genes, dtype=np.float64)
+            self.table = LeggedGaitTable(self.genes, settings.gait, settings.name)
+            self.mapping = MappingFunction.for_behaviours(controller.mapping, controller.behaviour)
+            self.lookup = PrimitiveLookup.build(controller.behaviour, self.mapping.domain())
+        self.settings = settings
+
+    def choose(self, out: np.ndarray) -> tuple[int, LeggedGaitTable | None, np.ndarray]:
+        """``(primitive index or -1, gait table, row)`` for one activation.
+
+        No table (None) when the outputs are not finite: no primitive runs this cycle.
+        """
+        if self.kind == "evorbc":
+            index = choose_primitive(self.mapping, self.lookup, out[0], out[1])[0]
+            if index == NO_PRIMITIVE:
+                return index, None, np.array([0])
+            return index, self.table, np.array([index])
+        if not np.all(np.isfinite(out)):
+            return NO_PRIMITIVE, None, np.array([0])
+        genes = 2.0 * np.clip(out, 0.0, 1.0) - 1.0
+        s = self.settings
+        return -1, LeggedGaitTable(genes, s.gait, s.name), np.array([0])
+
+
+class EpisodeRunner:
+    """Runs episodes in per-maze simulations kept alive between calls."""
+
+    def __init__(self, world: LeggedWorld):
+        self.world = world
+        self.scanner = world.scanner()
+        self.laser = LaserToRangefinders(world.layout.rangefinders)
+        self.goal = GoalInputs(world.layout)
+        self.sims: dict[int, LeggedSim] = {}
+        self.choosers: dict[str, _Chooser] = {}
+        physics = world.settings.physics
+        self.per_period = physics.steps(world.settings.control_period)
+        self.dt = physics.dt  # s per physics step, the gait clock's tick
+        self.fallen_tilt = world.settings.fallen_tilt
+
+    def chooser(self, controller: LeggedController) -> _Chooser:
+        """The chooser of ``controller`` (built once per controller key)."""
+        if controller.key not in self.choosers:
+            self.choosers = {controller.key: _Chooser(controller, self.world.settings)}
+        return self.choosers[controller.key]
+
+    def sim(self, maze: int) -> LeggedSim:
+        """The simulation of maze ``maze`` (built on first use)."""
+        if maze not in self.sims:
+            w = self.world
+            self.sims[maze] = LeggedSim(w.settings, w.mazes[maze].boxes)
+        return self.sims[maze]
+
+    def inputs(self, sim: LeggedSim, maze: Maze, base: tuple | None = None) -> np.ndarray:
+        """The arbitrator's inputs now: laser groups, then goal bearing.
+
+        ``base``: the body's :meth:`~LeggedSim.base_pose` read since the last step, or
+        None to read it now.
+        """
+        base = sim.base_pose() if base is None else base
+        s = self.scanner
+        ranges = s.scan(sim, base)
+        rf = self.laser.readings(s.angle_min, s.angle_increment, ranges, s.range_min, s.range_max)
+        (x, y, _), orn = base
+        yaw = yaw_from_quaternion(*orn)
+        goal = self.goal.readings(x, y, yaw, maze.target[0], maze.target[1])
+        return np.concatenate([rf, goal])
+
+    def run(
+        self,
+        network: NetworkSpec,
+        controller: LeggedController,
+        maze_index: int,
+        start: tuple[float, float, float],
+        record: bool = False,
+    ) -> dict:
+        """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index``.
+
+        Returns:
+            ``{"reached", "fell", "cycles", "final_distance", "initial_distance"}`` and,
+            with ``record``, ``"pose" (cycles + 1, 3)``, ``"choice" (cycles,)`` and
+            ``"outputs" (cycles, n_outputs)``.
+
+        """
+        maze = self.world.mazes[maze_index]
+        sim = self.sim(maze_index)
+        sim.reset(*start)
+        net = network.compile()
+        chooser = self.chooser(controller)
+        tx, ty = maze.target
+        # The body's pose is read once per cycle (a PyBullet state request each time) and
+        # serves the pose, the laser and the goal inputs until the next physics step.
+        base = sim.base_pose()
+        x, y, heading, _ = sim.pose(base)
+        initial = math.hypot(x - tx, y - ty)
+        distance = initial
+        reached = fell = False
+        poses, choices, outputs = [(x, y, heading)], [], []
+        cycles = self.world.n_cycles
+        # The executor's state: the physics step its gait clock started at (the first
+        # primitive), the last gait run and the target held while none runs (rad).
+        gait_start, last, last_row = None, None, None
+        held = sim.joint_states()[0]  # before any primitive: where the joints stand
+        for cycle in range(self.world.n_cycles):
+            out = net.activate(self.inputs(sim, maze, base))
+            index, table, row = chooser.choose(out)
+            if table is not None:
+                if gait_start is None:
+                    gait_start = sim.steps_done
+                last, last_row = table, row
+                times = gait_step_times(sim.steps_done - gait_start, self.per_period, self.dt)
+                targets = table.joint_targets(times, np.repeat(row, len(times)))
+                held = None
+            else:
+                if held is None:  # the last gait's target at this cycle's first step
+                    now = gait_step_times(sim.steps_done - gait_start, 1, self.dt)
+                    held = last.joint_targets(now, last_row)[0]
+                targets = np.repeat(held[None, :], self.per_period, axis=0)
+            tilt, _ = sim.run(targets, max_tilt=self.fallen_tilt)
+            base = sim.base_pose()
+            x, y, heading, _ = sim.pose(base)
+            distance = math.hypot(x - tx, y - ty)
+            if record:
+                poses.append((x, y, heading))
+                choices.append(index)
+                outputs.append(out)
+            if distance <= maze.target_radius:
+                reached, cycles = True, cycle + 1
+                break
+            if tilt > self.fallen_tilt:
+                fell = True  # cycles stays n_cycles: eq. 5 scores where it lies
+                break
+        result = {
+            "reached": reached,
+            "fell": fell,
+            "cycles": cycles,
+            "final_distance": distance,
+            "initial_distance": initial,
+        }
+        if record:
+            result["pose"] = np.array(poses)
+            result["choice"] = np.array(choices, dtype=np.int64)
+            result["outputs"] = np.array(outputs).reshape(len(choices), -1)
+        return result
+
+    def close(self) -> None:
+        """Disconnect every simulation."""
+        for sim in self.sims.values():
+            sim.close()
+        self.sims.clear()
