@@ -33,8 +33,11 @@ class DropoutRun(GraphRun):
             ros_args = node_command("relay", self.relay_params)[3:]  # from --ros-args on
             relay = [sys.executable, str(RELAY), *ros_args]
             self.spawn("scan_dropout_relay", relay)
-            # A refused scan leaves the bridge without commands: send the state again soon.
-            params = {**params, "lockstep_timeout": 1.0}
+            if self.relay_params["dropout"] > 0:
+                # A refused scan leaves the bridge without commands: send the state again
+                # soon. Not without dropouts: a cycle slower than this under load would be
+                # answered twice and shift every later choice (sim_bridge/bridge_node.py, wait_for_commands).
+                params = {**params, "lockstep_timeout": 1.0}
         cmd = node_command(module, params)
         if name == "laser_sensor":
             cmd += ["-r", "scan:=scan_dropped"]
