@@ -14,6 +14,7 @@ never a traceback (set ``EVORBC_DEBUG=1`` to see one for an unexpected failure).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Sequence
 
@@ -24,6 +25,7 @@ from evorbc_ros.repertoire import RepertoireError
 from offline_evolution.checkpoint import CheckpointError
 from offline_evolution.commands import arbitrator, repertoire, replay
 from offline_evolution.commands.common import EXIT_ERROR, EXIT_INTERRUPTED, CliError
+from sim_bridge.cluster_pool import CLUSTER_VARIABLE, ClusterError
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -44,12 +46,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``evorbc-evolve``; returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    if getattr(args, "cluster", None):
+        # The evaluation pools read it when they first spread work (sim_bridge/cluster_pool).
+        os.environ[CLUSTER_VARIABLE] = args.cluster
     try:
         return args.func(args)
     except CliError as e:
         print(f"evorbc-evolve: error: {e}", file=sys.stderr)
         return e.code
-    except (ConfigError, RepertoireError, CheckpointError, ArbitratorError) as e:
+    except (ConfigError, RepertoireError, CheckpointError, ArbitratorError, ClusterError) as e:
         print(f"evorbc-evolve: error: {e}", file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:

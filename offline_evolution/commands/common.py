@@ -112,8 +112,14 @@ def add_workers_option(parser: argparse.ArgumentParser) -> None:
         "--workers",
         type=count,
         metavar="N",
-        help="worker processes for robots simulated in PyBullet (default: one per core); "
-        "results are the same for any number",
+        help="worker processes for robots simulated in PyBullet (default: one per core; "
+        "with --cluster, one per cluster CPU); results are the same for any number",
+    )
+    parser.add_argument(
+        "--cluster",
+        metavar="ADDRESS",
+        help="spread PyBullet simulations over the Ray cluster at ADDRESS (host:port, "
+        "auto or ray://...; default: $EVORBC_CLUSTER, else this machine's cores)",
     )
 
 

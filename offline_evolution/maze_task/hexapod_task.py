@@ -70,6 +70,7 @@ class HexapodMazeTask(MazeTaskBase, SpawnedWorkers):
             tuple(self.mazes), self.layout, self.geometry, self.physics, self.n_cycles
         )
         self.workers = max(1, workers or available_cores())
+        self.cluster_workers = workers
 
     def describe(self) -> dict:
         """The simulated robot (geometry and physics), as repertoire files record it."""
@@ -112,7 +113,7 @@ class HexapodMazeTask(MazeTaskBase, SpawnedWorkers):
         return self.episode_result(reached, cycles, final, initial, traces, fell)
 
     def _map(self, jobs: list) -> list[dict]:
-        if self.workers == 1 or len(jobs) == 1:
+        if self.in_process() or len(jobs) == 1:
             if self._local is None:
                 self._local = EpisodeRunner(self.world)
             return [_run(self._local, job) for job in jobs]

@@ -9,7 +9,6 @@ an optional dependency (``pip install "evorbc[cluster]"``); nothing else imports
 
 from __future__ import annotations
 
-import socket
 import time
 from pathlib import Path
 
@@ -17,6 +16,7 @@ from offline_evolution.study.local import StudyInterrupted
 from offline_evolution.study.progress import StudyProgress
 from offline_evolution.study.run import RunError, RunInterrupted, RunRecord, execute
 from offline_evolution.study.spec import Run
+from sim_bridge.cluster_pool import ClusterError, probe
 
 #: Seconds between progress lines while nothing finishes.
 PROGRESS_EVERY = 60.0
@@ -57,15 +57,10 @@ def _probe(address: str) -> None:
     Raises:
         RunError: naming the address.
     """
-    host, sep, port = address.rpartition(":")
-    if not sep or "://" in address or not port.isdigit():
-        return  # "auto", "ray://...": Ray resolves those itself
     try:
-        socket.create_connection((host, int(port)), timeout=5.0).close()
-    except OSError as e:
-        raise RunError(
-            f"--address {address}: cannot connect to the Ray cluster ({e.strerror or e})"
-        ) from None
+        probe(address)
+    except ClusterError as e:
+        raise RunError(f"--address {address}: cannot connect to the Ray cluster ({e})") from None
 
 
 def run_on_ray(

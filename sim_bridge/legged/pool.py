@@ -19,6 +19,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
+from sim_bridge.cluster_pool import cluster_address
 from sim_bridge.legged.evaluate import evaluate_genes
 from sim_bridge.legged.physics import LeggedSim
 
@@ -56,11 +57,23 @@ class SpawnedWorkers:
     """
 
     workers: int = 1
+    #: Ray actors on a cluster (None: one per cluster CPU); see :meth:`_pool`.
+    cluster_workers: int | None = None
     _executor: ProcessPoolExecutor | None = None
     _local = None
 
     def _pool(self, initializer, initargs: tuple) -> ProcessPoolExecutor:
-        """The executor, started on first use with ``initializer(*initargs)`` per worker."""
+        """The executor, started on first use with ``initializer(*initargs)`` per worker.
+
+        With a cluster address (``EVORBC_CLUSTER``) the workers are Ray actors on the
+        cluster instead of processes here (:mod:`sim_bridge.cluster_pool`); results are
+        the same either way.
+        """
+        address = cluster_address()
+        if self._executor is None and address:
+            from sim_bridge.cluster_pool import ClusterExecutor
+
+            self._executor = ClusterExecutor(address, initializer, initargs, self.cluster_workers)
         if self._executor is None:
             self._executor = ProcessPoolExecutor(
                 self.workers,
@@ -69,6 +82,10 @@ class SpawnedWorkers:
                 initargs=initargs,
             )
         return self._executor
+
+    def in_process(self) -> bool:
+        """Whether work runs here: one worker and no cluster (``EVORBC_CLUSTER``)."""
+        return self.workers == 1 and not cluster_address()
 
     def close(self) -> None:
         """Stop the workers and the in-process simulation."""
@@ -105,6 +122,7 @@ class EvaluationPool(SpawnedWorkers):
     def __init__(self, make_sim: Callable[[], LeggedSim], workers: int | None = None) -> None:
         self.make_sim = make_sim
         self.workers = max(1, workers or available_cores())
+        self.cluster_workers = workers
 
     def evaluate(
         self, genes: np.ndarray, eval_time: float, control_period: float, max_tilt: float
@@ -113,7 +131,7 @@ class EvaluationPool(SpawnedWorkers):
         genes = np.atleast_2d(np.asarray(genes, dtype=np.float64))
         if len(genes) == 0:
             return np.empty((0, 6))
-        if self.workers == 1:
+        if self.in_process():
             if self._local is None:
                 self._local = self.make_sim()
             return evaluate_genes(self._local, genes, eval_time, control_period, max_tilt)

@@ -1,0 +1,125 @@
+"""A legged robot's evaluations within one run spread over a real two-node Ray cluster
+(``--cluster`` / ``EVORBC_CLUSTER``): the same results as on one process, also after
+losing a node mid-batch."""
+
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from hexapod_helpers import tripod_repertoire
+from ray_cluster import LocalCluster, free_port
+
+from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
+from offline_evolution.maze_task.task import MazeTaskSettings
+from sim_bridge.robots.hexapod import HexapodRobot
+
+pytest.importorskip("ray")
+
+GENES_SEED = 5
+N_PRIMITIVES = 240
+EVAL_TIME = 2.0  # s
+# Runs in its own process, connected to the cluster through EVORBC_CLUSTER, as the CLI is.
+PRIMITIVES = f"""
+import sys, numpy as np
+from sim_bridge.robots.hexapod import HexapodRobot
+genes = np.random.default_rng({GENES_SEED}).uniform(-1, 1, ({N_PRIMITIVES}, 37))
+robot = HexapodRobot(workers=int(sys.argv[2]) if len(sys.argv) > 2 else None)
+print("started", flush=True)
+out = robot.evaluate_primitives(genes, {EVAL_TIME})
+np.save(sys.argv[1], np.stack([out.x, out.y, out.heading, out.path, out.max_tilt]))
+robot.close()
+"""
+EPISODES = """
+import sys, numpy as np
+sys.path.insert(0, "tests")
+from test_cluster_pool import episodes
+np.save(sys.argv[1], episodes(workers=None))
+"""
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    c = LocalCluster()
+    yield c
+    c.stop()
+
+
+def on_cluster(cluster, script, out, *args):
+    env = dict(cluster.env, EVORBC_CLUSTER=cluster.address)
+    return subprocess.Popen(
+        [sys.executable, "-c", script, str(out), *map(str, args)],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+
+
+def local_primitives():
+    genes = np.random.default_rng(GENES_SEED).uniform(-1, 1, (N_PRIMITIVES, 37))
+    robot = HexapodRobot(workers=1)
+    try:
+        out = robot.evaluate_primitives(genes, EVAL_TIME)
+    finally:
+        robot.close()
+    return np.stack([out.x, out.y, out.heading, out.path, out.max_tilt])
+
+
+def episodes(workers):
+    """Recorded poses and fitness of 3 networks x 2 starts, 2 s hexapod episodes."""
+    from test_hexapod_task import networks
+
+    settings = MazeTaskSettings(("hexapod",), 2.0, 1, "sensors/hexapod.yaml")
+    task = HexapodMazeTask(settings, workers=workers)
+    try:
+        controller = task.controller("evorbc", tripod_repertoire(), "polar")
+        starts = np.array([[0, -3.5, 0.0, 0.0], [0, -3.4, 0.3, 1.0]])
+        r = task.evaluate(networks(2), controller, starts, record=True)
+    finally:
+        task.close()
+    return np.concatenate([r.pose.ravel(), r.fitness, r.choice.ravel()])
+
+
+@pytest.mark.slow
+def test_primitives_on_the_cluster_match_one_process_after_losing_a_node(cluster, tmp_path):
+    out = tmp_path / "cluster.npy"
+    proc = on_cluster(cluster, PRIMITIVES, out)
+    assert proc.stdout.readline().strip() == "started"
+    time.sleep(3.0)  # both nodes are evaluating chunks
+    assert proc.poll() is None, "finished before the node was lost: nothing was tested"
+    cluster.kill_worker_node()
+    text, _ = proc.communicate(timeout=600)
+    assert proc.returncode == 0, text
+    np.testing.assert_array_equal(np.load(out), local_primitives())
+
+
+@pytest.mark.slow
+def test_episodes_on_the_cluster_match_one_process(tmp_path):
+    c = LocalCluster()  # a fresh cluster: the other test loses a node
+    try:
+        out = tmp_path / "episodes.npy"
+        proc = on_cluster(c, EPISODES, out)
+        text, _ = proc.communicate(timeout=600)
+        assert proc.returncode == 0, text
+    finally:
+        c.stop()
+    np.testing.assert_array_equal(np.load(out), episodes(workers=1))
+
+
+def test_an_unreachable_cluster_is_one_line(tmp_path):
+    env = dict(os.environ, RAY_USAGE_STATS_ENABLED="0")
+    result = subprocess.run(
+        [
+            sys.executable, "-m", "offline_evolution.cli", "repertoire", "--robot", "hexapod",
+            "--iterations", "1", "--initial-batch", "20", "--batch-size", "20",
+            "--cluster", f"127.0.0.1:{free_port()}", "--out", str(tmp_path / "r.json"),
+        ],
+        env=env, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert result.returncode == 1, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("evorbc-evolve: error: cluster 127.0.0.1:")
+    assert not (tmp_path / "r.json").exists()
