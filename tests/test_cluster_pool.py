@@ -2,6 +2,7 @@
 (``--cluster`` / ``EVORBC_CLUSTER``): the same results as on one process, also after
 losing a node mid-batch."""
 
+import json
 import os
 import subprocess
 import sys
@@ -83,6 +84,28 @@ def episodes(workers):
     return np.concatenate([r.pose.ravel(), r.fitness, r.choice.ravel()])
 
 
+def repertoire_command(out, *extra):
+    return [
+        sys.executable, "-m", "offline_evolution.cli", "repertoire", "--robot", "hexapod",
+        "--iterations", "2", "--initial-batch", "40", "--batch-size", "20", "--seed", "3",
+        "--quiet", "--out", str(out), *extra,
+    ]  # fmt: skip
+
+
+@pytest.mark.slow
+def test_a_repertoire_run_with_cluster_writes_the_same_file(cluster, tmp_path):
+    env = dict(cluster.env)
+    env.pop("EVORBC_CLUSTER", None)
+    spread = repertoire_command(tmp_path / "c.json", "--cluster", cluster.address)
+    local = repertoire_command(tmp_path / "l.json", "--workers", "1")
+    for cmd in (spread, local):
+        done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, done.stderr
+    on_cluster_file, local_file = (json.loads((tmp_path / f"{k}.json").read_text()) for k in "cl")
+    assert on_cluster_file["primitives"] == local_file["primitives"]
+    assert len(local_file["primitives"]["genes"]) > 0
+
+
 @pytest.mark.slow
 def test_primitives_on_the_cluster_match_one_process_after_losing_a_node(cluster, tmp_path):
     out = tmp_path / "cluster.npy"
@@ -123,3 +146,17 @@ def test_an_unreachable_cluster_is_one_line(tmp_path):
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("evorbc-evolve: error: cluster 127.0.0.1:")
     assert not (tmp_path / "r.json").exists()
+
+
+def test_a_study_spread_needs_a_cluster_and_runs_take_only_their_cpus(tmp_path):
+    from study_helpers import run_study, write_tiny_study
+
+    from offline_evolution.study.run import commands
+    from offline_evolution.study.spec import load_study
+
+    study = write_tiny_study(tmp_path)
+    result = run_study("run", study, "--results", tmp_path / "r", "--spread", "2")
+    assert result.returncode != 0
+    assert result.stderr.strip().endswith("--spread needs a Ray cluster (--address or RAY_ADDRESS)")
+    run = load_study(study).runs()[0]
+    assert all(cmd[-2:] == ["--workers", "3"] for cmd in commands(run, tmp_path, 3))

@@ -73,6 +73,13 @@ def build_parser() -> argparse.ArgumentParser:
                 help="Ray cluster to run on (default: $RAY_ADDRESS; none: this machine)",
             )
             s.add_argument(
+                "--spread",
+                type=integer_in(1),
+                metavar="N",
+                help="Ray: N runs at once, each spreading its PyBullet simulations over the "
+                "whole cluster (for legged robots, whose runs are hours on one machine)",
+            )
+            s.add_argument(
                 "--retries",
                 type=int,
                 default=3,
@@ -207,6 +214,8 @@ def cmd_run(args) -> int:
 
     study, runs = _selected_runs(args)
     results = Path(args.results)
+    if args.spread and not args.address:
+        raise StudyError("--spread needs a Ray cluster (--address or RAY_ADDRESS)")
     jobs = args.jobs or max(1, (os.cpu_count() or 1) // args.threads)
     with ResultsLock(results):
         progress = StudyProgress(study.name, runs, jobs)
@@ -227,7 +236,7 @@ def cmd_run(args) -> int:
                 from offline_evolution.study.cluster import run_on_ray
 
                 failed = run_on_ray(
-                    todo, results, args.address, args.threads, args.retries, progress
+                    todo, results, args.address, args.threads, args.retries, progress, args.spread
                 )
             else:
                 failed = run_local(todo, results, jobs, args.threads, progress)

@@ -22,9 +22,11 @@ from sim_bridge.cluster_pool import ClusterError, probe
 PROGRESS_EVERY = 60.0
 
 
-def _execute_on_node(run: Run, results: str, threads: int) -> tuple[float, dict]:
+def _execute_on_node(
+    run: Run, results: str, threads: int, cluster: str | None
+) -> tuple[float, dict]:
     """The Ray task: run or resume ``run``; returns its wall seconds and summary."""
-    record: RunRecord = execute(run, Path(results), threads)
+    record: RunRecord = execute(run, Path(results), threads, cluster)
     return record.seconds, record.summary
 
 
@@ -70,8 +72,14 @@ def run_on_ray(
     threads: int,
     retries: int,
     progress: StudyProgress,
+    spread: int | None = None,
 ) -> int:
     """Run every run as a Ray task on the cluster at ``address``.
+
+    Each task asks for ``threads`` CPUs. With ``spread`` (runs at once), a PyBullet
+    robot's simulations go to the whole cluster instead (``--cluster``, one Ray task per
+    chunk): a run's own task then asks for no CPU, as it only waits for its chunks, and
+    ``spread`` runs go at once.
 
     Returns:
         The number of runs that failed (their ``run.log`` says why).
@@ -81,13 +89,17 @@ def run_on_ray(
     """
     ray = connect(address)
     try:
-        capacity = max(1, int(ray.cluster_resources().get("CPU", 1)) // threads)
+        capacity = spread or max(1, int(ray.cluster_resources().get("CPU", 1)) // threads)
         progress.parallel = capacity
-        task = ray.remote(num_cpus=threads, max_retries=retries, retry_exceptions=False)(
-            _execute_on_node
-        )
+        task = ray.remote(
+            num_cpus=0 if spread else threads, max_retries=retries, retry_exceptions=False
+        )(_execute_on_node)
         folder = str(results.resolve())
-        pending = {task.remote(run, folder, threads): run for run in runs}
+        cluster = address if spread else None
+        # Without spread Ray queues every task by its CPUs (a node that joins takes some
+        # at once); a spread run asks for none, so no more than ``spread`` are handed out.
+        submitted = runs[:capacity] if spread else runs
+        pending = {task.remote(run, folder, threads, cluster): run for run in submitted}
         for run in runs[:capacity]:
             progress.start(run)
         queue = list(runs[capacity:])
@@ -104,7 +116,10 @@ def run_on_ray(
                 ref = ready[0]
                 run = pending.pop(ref)
                 if queue:  # Ray starts the next queued task in the freed slot
-                    progress.start(queue.pop(0))
+                    nxt = queue.pop(0)
+                    progress.start(nxt)
+                    if spread:
+                        pending[task.remote(nxt, folder, threads, cluster)] = nxt
                 try:
                     seconds, _ = ray.get(ref)
                     progress.finished(run, seconds, fresh=True)

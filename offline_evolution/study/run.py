@@ -36,6 +36,7 @@ from pathlib import Path
 
 from evorbc_ros.atomic_io import atomic_write
 from offline_evolution.study.spec import Run
+from sim_bridge.cluster_pool import CLUSTER_VARIABLE
 
 RUN_FILE = "run.json"
 FORMAT = "evorbc-study-run"
@@ -96,11 +97,13 @@ def check_settings(run: Run, folder: Path) -> None:
         )
 
 
-def commands(run: Run, folder: Path) -> list[list[str]]:
+def commands(run: Run, folder: Path, workers: int | None = None) -> list[list[str]]:
     """The ``evorbc-evolve`` command lines of ``run`` (relative to ``folder``).
 
     Only the keys the setting names are passed; everything else comes from the robot's
-    shipped settings files (Table I), as for any run started by hand.
+    shipped settings files (Table I), as for any run started by hand. ``workers`` caps a
+    PyBullet robot's simulation processes (``--workers``; the 4WS kernels ignore it), so
+    a run takes the CPUs it was given and no more.
     """
     v = run.values
     cli = [sys.executable, "-m", "offline_evolution.cli"]
@@ -127,6 +130,8 @@ def commands(run: Run, folder: Path) -> list[list[str]]:
     # The fitness curve goes to a scratch name that is removed once the run is finished:
     # the study report draws its own figures from the histories.
     out.append([*arb, "--out", "arbitrator.json", "--plot", "fitness-curve.png", "--quiet"])
+    if workers:
+        out = [[*cmd, "--workers", str(workers)] for cmd in out]
     return out
 
 
@@ -189,14 +194,17 @@ def interrupt_all() -> None:
                 proc.send_signal(signal.SIGINT)
 
 
-def execute(run: Run, results: Path, threads: int = 1) -> RunRecord:
+def execute(run: Run, results: Path, threads: int = 1, cluster: str | None = None) -> RunRecord:
     """Run (or resume, or finish) ``run`` in its folder under ``results``.
 
     The commands' output goes to ``run.log`` in the run's folder.
 
     Args:
-        threads: numba threads per command (``NUMBA_NUM_THREADS``); results do not depend
-            on it.
+        threads: numba threads per command (``NUMBA_NUM_THREADS``), and a PyBullet
+            robot's simulation processes; results do not depend on it.
+        cluster: a Ray cluster address: a PyBullet robot's simulations go there
+            (``EVORBC_CLUSTER``, one CPU per chunk in flight) instead of ``threads``
+            local processes.
 
     Raises:
         RunInterrupted: a command was stopped by a signal (its checkpoint is kept).
@@ -208,8 +216,11 @@ def execute(run: Run, results: Path, threads: int = 1) -> RunRecord:
         return RunRecord.load(folder)
     folder.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ, NUMBA_NUM_THREADS=str(threads), PYTHONUNBUFFERED="1")
+    env.pop(CLUSTER_VARIABLE, None)
+    if cluster:
+        env[CLUSTER_VARIABLE] = cluster
     with open(folder / "run.log", "a", encoding="utf-8") as log:
-        for cmd in commands(run, folder):
+        for cmd in commands(run, folder, None if cluster else threads):
             target = folder / cmd[cmd.index("--out") + 1]
             if target.exists() or target.with_name(target.name + ".xz").exists():
                 continue  # finished by an earlier attempt
