@@ -24,8 +24,8 @@ import statistics
 import time
 
 import numba
-
 from bench_repertoire import machine
+
 from evorbc_ros.config import config_dir
 from offline_evolution.arbitrator.evolve import EvolutionSettings, evolve, file_sha256
 from offline_evolution.maze_task.task import MazeTaskSettings

@@ -1,6 +1,7 @@
 """Shared fixtures."""
 
 import pytest
+from study_helpers import run_study, write_tiny_study
 
 from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
@@ -56,3 +57,15 @@ def small_task_file(tmp_path):
     path = tmp_path / "task.yaml"
     path.write_text(yaml.safe_dump(SMALL_TASK))
     return path
+
+
+@pytest.fixture(scope="session")
+def serial_results(tmp_path_factory):
+    """The tiny study (tests/study_helpers.py) run serially, uninterrupted: the reference
+    of the study-runner and Ray tests."""
+    folder = tmp_path_factory.mktemp("serial")
+    study = write_tiny_study(folder)
+    result = run_study("run", study, "--results", folder / "results", "--jobs", "1")
+    assert result.returncode == 0, result.stderr
+    assert "study tiny: 2 done, 0 running, 0 left" in result.stderr
+    return folder / "results"

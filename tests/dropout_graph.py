@@ -36,7 +36,8 @@ class DropoutRun(GraphRun):
             if self.relay_params["dropout"] > 0:
                 # A refused scan leaves the bridge without commands: send the state again
                 # soon. Not without dropouts: a cycle slower than this under load would be
-                # answered twice and shift every later choice (sim_bridge/bridge_node.py, wait_for_commands).
+                # answered twice and shift every later choice (the bridge's
+                # wait_for_commands).
                 params = {**params, "lockstep_timeout": 1.0}
         cmd = node_command(module, params)
         if name == "laser_sensor":

@@ -107,6 +107,16 @@ def test_a_repertoire_run_with_cluster_writes_the_same_file(cluster, tmp_path):
 
 
 @pytest.mark.slow
+def test_episodes_on_the_cluster_match_one_process(cluster, tmp_path):
+    out = tmp_path / "episodes.npy"
+    proc = on_cluster(cluster, EPISODES, out)
+    text, _ = proc.communicate(timeout=600)
+    assert proc.returncode == 0, text
+    np.testing.assert_array_equal(np.load(out), episodes(workers=1))
+
+
+# Last of the cluster's tests: it loses the worker node.
+@pytest.mark.slow
 def test_primitives_on_the_cluster_match_one_process_after_losing_a_node(cluster, tmp_path):
     out = tmp_path / "cluster.npy"
     proc = on_cluster(cluster, PRIMITIVES, out)
@@ -117,19 +127,6 @@ def test_primitives_on_the_cluster_match_one_process_after_losing_a_node(cluster
     text, _ = proc.communicate(timeout=600)
     assert proc.returncode == 0, text
     np.testing.assert_array_equal(np.load(out), local_primitives())
-
-
-@pytest.mark.slow
-def test_episodes_on_the_cluster_match_one_process(tmp_path):
-    c = LocalCluster()  # a fresh cluster: the other test loses a node
-    try:
-        out = tmp_path / "episodes.npy"
-        proc = on_cluster(c, EPISODES, out)
-        text, _ = proc.communicate(timeout=600)
-        assert proc.returncode == 0, text
-    finally:
-        c.stop()
-    np.testing.assert_array_equal(np.load(out), episodes(workers=1))
 
 
 def test_an_unreachable_cluster_is_one_line(tmp_path):

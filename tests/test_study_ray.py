@@ -24,11 +24,10 @@ def cluster():
 
 
 @pytest.mark.slow
-def test_a_study_survives_losing_a_node_with_results_identical_to_a_serial_run(cluster, tmp_path):
+def test_a_study_survives_losing_a_node_with_results_identical_to_a_serial_run(
+    cluster, tmp_path, serial_results
+):
     study = write_tiny_study(tmp_path)
-    serial = tmp_path / "serial"
-    done = run_study("run", study, "--results", serial, "--jobs", "1")
-    assert done.returncode == 0, done.stderr
 
     results = tmp_path / "ray"
     proc = subprocess.Popen(
@@ -47,7 +46,7 @@ def test_a_study_survives_losing_a_node_with_results_identical_to_a_serial_run(c
     assert "study tiny: 2 done, 0 running, 0 left" in out
     logs = [p.read_text() for p in results.rglob("run.log")]
     assert any(log.count("$ evorbc-evolve arbitrator") == 2 for log in logs)  # retried
-    assert results_contents(results) == results_contents(serial)
+    assert results_contents(results) == results_contents(serial_results)
 
 
 def test_an_unreachable_cluster_is_one_line(tmp_path):

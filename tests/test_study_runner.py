@@ -72,17 +72,6 @@ def test_an_unknown_study_lists_the_known_ones():
     ]
 
 
-@pytest.fixture(scope="module")
-def serial_results(tmp_path_factory):
-    """The tiny study run serially, uninterrupted: the reference."""
-    folder = tmp_path_factory.mktemp("serial")
-    study = write_tiny_study(folder)
-    result = run_study("run", study, "--results", folder / "results", "--jobs", "1")
-    assert result.returncode == 0, result.stderr
-    assert "study tiny: 2 done, 0 running, 0 left" in result.stderr
-    return folder / "results"
-
-
 def test_a_finished_run_holds_its_files_and_record(serial_results):
     run = serial_results / "approach-evorbc" / "seed-001"
     assert sorted(p.name for p in run.iterdir()) == [

@@ -8,6 +8,8 @@ side of a left/right symmetric robot.
 
 from __future__ import annotations
 
+import copy
+import functools
 import math
 
 import numpy as np
@@ -40,6 +42,9 @@ CVT_SAMPLES = 100_000
 def cvt_layout(max_reach: float, bin_size: float, seed: int) -> dict:
     """A CVT over the same square as :func:`grid_layout`, with as many cells (to within one).
 
+    k-means is seconds for a Table I archive: a process computes each layout once
+    (a fresh copy each call, so no caller changes another's).
+
     The cells then have the grid's mean area, so cell counts of the two archives compare.
     k-means runs on the half-plane ``y >= 0``; the centroids and their mirror images
     ``(x, -y)`` make the archive exactly left/right symmetric.
@@ -49,6 +54,11 @@ def cvt_layout(max_reach: float, bin_size: float, seed: int) -> dict:
         centroids are stored so a resumed run or a reader needs no k-means.
 
     """
+    return copy.deepcopy(_cvt_layout(float(max_reach), float(bin_size), int(seed)))
+
+
+@functools.lru_cache(maxsize=8)
+def _cvt_layout(max_reach: float, bin_size: float, seed: int) -> dict:
     grid = grid_layout(max_reach, bin_size)
     (low, _), (high, _) = grid["low"], grid["high"]
     half = grid["dims"][0] * grid["dims"][1] // 2
