@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy.ndimage import binary_dilation, label
@@ -47,17 +48,27 @@ class Field:
     towards: np.ndarray  # (ny, nx) flat index of the next cell towards the target (-1: none)
     snap: float = SNAP  # m, how far a point may step to the nearest free cell
 
-    def distances_at(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    @cached_property
+    def snapped(self) -> np.ndarray:
+        """See :func:`snapped_distance`."""
+        from scipy.ndimage import grey_erosion
+
+        free_distance = np.where(self.free, self.distance, np.inf)
+        return grey_erosion(free_distance, footprint=_snap_disc(self))
+
+    def to_go(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Shortest path lengths (m) to the target from points ``(k,)`` (x, y in m).
 
-        Through the cell nearest each point: inf where that cell is not free or cut off.
-
-        A cheap per-pose look-up for traces; :meth:`distance_from` is exact at one point.
+        Each point takes the cell it lies in and the best free cell within ``snap`` of it
+        (a robot may sit closer to a wall than the margin); inf where there is none. Cheap
+        for whole traces; :meth:`distance_from` measures one point exactly.
         """
+        best = self.snapped
         cell = self.xs[1] - self.xs[0]
-        i = np.clip(np.rint((np.asarray(x) - self.xs[0]) / cell).astype(int), 0, len(self.xs) - 1)
-        j = np.clip(np.rint((np.asarray(y) - self.ys[0]) / cell).astype(int), 0, len(self.ys) - 1)
-        return np.where(self.free[j, i], self.distance[j, i], np.inf)
+        i = np.rint((np.asarray(x) - self.xs[0]) / cell).astype(int)
+        j = np.rint((np.asarray(y) - self.ys[0]) / cell).astype(int)
+        i, j = np.clip(i, 0, len(self.xs) - 1), np.clip(j, 0, len(self.ys) - 1)
+        return best[j, i]
 
     def distance_from(self, x: float, y: float) -> float:
         """Shortest path length (m) from ``(x, y)`` to the target; inf if there is none."""
@@ -291,16 +302,22 @@ def stranded_starts(maze: Maze, field: Field, robot_radius: float = ROBOT_RADIUS
     return int((start_cells(maze, field, robot_radius) & ~near).sum())
 
 
+def snapped_distance(field: Field) -> np.ndarray:
+    """``(ny, nx)`` distance (m) to the target from each cell, via the best free cell near it.
+
+    The best free cell within ``field.snap`` (a min filter over the snap disc); inf where
+    there is none. Computed once per field.
+    """
+    return field.snapped
+
+
 def longest_start_path(maze: Maze, field: Field, robot_radius: float = ROBOT_RADIUS) -> float:
     """The longest shortest path (m) from any start cell that clears the robot.
 
     Each start cell takes the best free cell within ``field.snap`` m, as
     :meth:`Field.distance_from` does; inf if some start cannot reach the target.
     """
-    from scipy.ndimage import grey_erosion
-
-    # The smallest distance within the snap disc, per cell (a min filter over the disc).
-    best = grey_erosion(np.where(field.free, field.distance, np.inf), footprint=_snap_disc(field))
+    best = snapped_distance(field)
     region = start_cells(maze, field, robot_radius)
     return float(best[region].max()) if region.any() else math.inf
 
