@@ -69,8 +69,8 @@ def timed_suite(task, arb, repertoire, starts: int, perturbation) -> tuple[float
 def report(label: str, n: int, total: float, episodes: float, cycles: int) -> None:
     print(
         f"{label:<46} {n:>5} episodes: {n / total:7.1f} episodes/s in all ({total:6.2f} s); "
-        f"episodes alone {n / episodes:7.1f}/s ({episodes:6.2f} s, {cycles / episodes / 1e6:.2f}M "
-        "cycles/s)"
+        f"episodes alone {n / episodes:7.1f}/s ({episodes:6.2f} s, {cycles / episodes / 1e3:.1f}k "
+        "control cycles/s)"
     )
 
 
@@ -103,7 +103,8 @@ def hexapod(starts: int) -> None:
     repertoire = Repertoire.load(default_repertoire("hexapod"))
     task = make_task(MazeTaskSettings(("hexapod",), 30.0, 1, "sensors/hexapod.yaml"), "hexapod")
     try:
-        timed_suite(task, arb, repertoire, 1, NONE)  # start the workers
+        # Start the workers and build their simulations (one start would run in process).
+        timed_suite(task, arb, repertoire, task.workers, NONE)
         for pset in (NONE, load_perturbations("realistic")):
             total, alone, cycles = timed_suite(task, arb, repertoire, starts, pset)
             label = f"hexapod, its maze x {starts}, {pset.name} ({task.workers} workers)"

@@ -127,3 +127,23 @@ def test_mazes_command_refuses_a_file_as_its_folder(tmp_path, capsys):
     assert main(["mazes", "--count", "1", "--out", str(path)]) == 1
     err = capsys.readouterr().err
     assert "--out" in err and "expected a folder" in err and len(err.strip().splitlines()) == 1
+
+
+def test_any_registered_robot_gets_mazes_sized_from_its_registration(monkeypatch):
+    import dataclasses
+
+    from evorbc_ros.robots import registry
+
+    monkeypatch.setattr(registry, "_registry", registry.Registry())
+    wide = dataclasses.replace(
+        registry.lookup("4ws-5"), name="wide-4ws", footprint_radius=0.08, maze="gaps"
+    )
+    registry.register(wide)
+    spec = spec_for_robot("wide-4ws")
+    assert spec.margin == pytest.approx(0.096) and spec.robot_radius == 0.08
+    assert spec.narrow_gap[0] == pytest.approx(0.28, abs=0.011)  # gaps' narrowest gap
+    for k in range(3):
+        maze = generate_maze(spec, 2, k).maze
+        field = solve(maze, spec.cell, spec.margin, spec.snap)
+        assert stranded_starts(maze, field, 0.08) == 0
+        assert field.distance_from(*maze.start_pose[:2]) <= spec.path_limit

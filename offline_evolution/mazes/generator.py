@@ -22,7 +22,8 @@ by :mod:`sim_bridge.maze_plot`), made for one robot (docs/design.md section 21):
   paper's mazes), ``open`` (far from every wall), ``behind`` (in the lee of the last
   obstacle, behind a turn around its tip) or ``anywhere`` (any clear point of the maze's
   right half, with obstacles beyond it).
-* **Proof.** A maze is kept only if the clearance-aware path search
+* **Proof.** A maze is kept only if at least :data:`MIN_OBSTACLES` obstacles (open
+  chambers not counted) lie before the target, and the clearance-aware path search
   (:mod:`offline_evolution.mazes.paths`) connects every start cell that clears the robot
   to the target, the longest such path is within the limit, and the narrowest gap on the
   widest route is at least the design's narrowest (less two grid cells); otherwise the
@@ -53,6 +54,9 @@ TARGET_MODES = ("wall", "open", "behind", "anywhere")
 _TARGET_WEIGHTS = (0.3, 0.25, 0.25, 0.2)
 #: Draws per maze before giving up (a few in a hundred fail the proof).
 MAX_TRIES = 200
+#: Obstacles (not counting open chambers) that must lie before the target, so that no
+#: maze is nearly empty: the hexapod's own maze has three baffles.
+MIN_OBSTACLES = 3
 
 
 @dataclass(frozen=True)
@@ -122,12 +126,12 @@ def spec_for_robot(name: str) -> MazeSpec:
         margin=margin,
         narrow_gap=(gap, 1.25 * gap),
         opening=(min(1.3 * gap, 0.55 * height), min(2.0 * gap, 0.6 * height)),
-        spacing=(max(0.6 * height, 1.5 * gap), max(1.3 * height, 2.0 * gap)),
+        spacing=(max(0.6 * height, 1.2 * gap), max(1.1 * height, 2.0 * gap)),
         start_offset=maze.start_x[0] - inner_left,
         start_length=maze.start_x[1] - maze.start_x[0],
         start_inset=max(0.0, min(maze.start_y[0] - (y0 + t), (y1 - t) - maze.start_y[1])),
         start_heading_deg=tuple(math.degrees(h) for h in maze.start_heading),
-        first_obstacle=maze.start_x[1] - inner_left + max(2 * margin, 0.2),
+        first_obstacle=maze.start_x[1] - inner_left + max(margin, 0.2),
         target_radius=maze.target_radius,
         path_limit=min(1.1 * path, 2.0 / 3.0 * robot.max_speed * robot.episode_time),
         cell=cell,
@@ -164,6 +168,7 @@ class _Draft:
     spec: MazeSpec
     walls: list = field(default_factory=list)
     kinds: list = field(default_factory=list)
+    starts: list = field(default_factory=list)  # x (m) where each obstacle's slot begins
     # (x of the obstacle's downstream face, side it hangs from: +1 top, -1 bottom)
     last_face: tuple[float, int] | None = None
 
@@ -233,6 +238,7 @@ def _place(draft: _Draft, kind: str, a: float, b: float, rng: np.random.Generato
     else:  # pragma: no cover - KINDS lists every kind
         raise ValueError(kind)
     draft.kinds.append(kind)
+    draft.starts.append(a)
 
 
 def _slot_length(kind: str, spec: MazeSpec, rng: np.random.Generator) -> float:
@@ -337,6 +343,11 @@ def generate_maze(spec: MazeSpec, seed: int, index: int, prefix: str = "gen") ->
     name = f"{prefix}{seed}-{index:03d}"
     for attempt in range(1, MAX_TRIES + 1):
         data, draft, mode = _draw(spec, rng, name)
+        before = [
+            k for k, a in zip(draft.kinds, draft.starts, strict=True) if a < data["target"][0]
+        ]
+        if sum(k != "chamber" for k in before) < MIN_OBSTACLES:
+            continue  # too easy: draw again
         try:
             maze = maze_from_dict(data, name)
         except ConfigError:
