@@ -173,6 +173,9 @@ def test_bad_perturbation_sets_are_named(tmp_path, capsys):
     assert "unknown key 'frictions'" in capsys.readouterr().err
 
 
-def test_an_empty_maze_folder_is_refused(tmp_path, capsys):
+def test_an_empty_maze_folder_and_one_file_for_two_outputs_are_refused(tmp_path, capsys):
     assert main(["evaluate", "--mazes", str(tmp_path)]) == 1
     assert "holds no .yaml maze files" in capsys.readouterr().err
+    both = str(tmp_path / "r.png")
+    assert main(["evaluate", "--plot", both, "--out", both]) == 1
+    assert "--plot and --out name the same file" in capsys.readouterr().err

@@ -123,6 +123,8 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     from offline_evolution.memory import check_replay_memory
     from sim_bridge.robots.base import control_steps
 
+    if args.plot and args.out and Path(args.plot).resolve() == Path(args.out).resolve():
+        raise CliError(f"--plot and --out name the same file {args.out}")
     for path, option, picture in ((args.plot, "--plot", True), (args.out, "--out", False)):
         if path:
             check_output_file(path, option, picture=picture)
