@@ -10,7 +10,7 @@ by :mod:`sim_bridge.maze_plot`), made for one robot (docs/design.md section 21):
   drives at its top speed in an episode); its footprint radius gives the margin every
   path keeps from the walls (1.2 times the radius; 0.06 m for the 4WS robots, as in
   ``tests/test_mazes.py``). For the 4WS robots that is an 11.1 x 1.39 m maze with
-  0.27-0.34 m gaps and at most 16 m of path; for the hexapod 8.0 x 2.0 m, about 1 m gaps,
+  0.27-0.33 m gaps and at most 16 m of path; for the hexapod 8.0 x 2.0 m, about 1 m gaps,
   at most 8.6 m.
 * **Obstacles**, left to right after the start zone, one per slot: ``baffle`` (from the top
   or bottom wall, an opening at its tip), ``gap`` (a full-height wall with one narrow gap),
