@@ -1,10 +1,10 @@
 """Shipped mazes: the paper's five, 11.0 x 1.4 m, each solvable with margin in an episode.
 
-Solvability is proved with the clearance-aware grid search of ``maze_paths`` (0.01 m cells,
-free where the clearance is >= 0.06 m), from the nominal start, from 50 seeded random starts
-and from every clear point of the start region. The four designed mazes must be no harder than
-``obstacle``, the original authors' maze: no longer a shortest path and no longer wall-following
-paths.
+Solvability is proved with the clearance-aware grid search of ``offline_evolution.mazes.paths``
+(0.01 m cells, free where the clearance is >= 0.06 m), from the nominal start, from 50 seeded random
+starts and from every clear point of the start region. The four designed mazes must be no harder
+than ``obstacle``, the original authors' maze: no longer a shortest path and no longer
+wall-following paths.
 """
 
 from __future__ import annotations
@@ -14,7 +14,9 @@ import functools
 import numpy as np
 import pytest
 import yaml
-from maze_paths import (
+
+from evorbc_ros.config import ConfigError
+from offline_evolution.mazes.paths import (
     MARGIN,
     ROBOT_RADIUS,
     backtrack,
@@ -23,8 +25,6 @@ from maze_paths import (
     stranded_starts,
     wall_followers,
 )
-
-from evorbc_ros.config import ConfigError
 from sim_bridge.maze import load_maze, load_named_maze, maze_from_dict, maze_names
 from sim_bridge.maze_plot import plot_mazes
 

@@ -107,6 +107,44 @@ def resolve_repertoire(
     )
 
 
+def controller_inputs(arb: ArbitratorFile, arb_path: Path, args: argparse.Namespace):
+    """``(repertoire or None, its path or None, task settings)`` to run ``arb`` with.
+
+    The repertoire as :func:`resolve_repertoire` finds it (``args.repertoire``,
+    ``args.allow_mismatch``; warnings go to stderr), the task from ``args.task``, else the
+    one the arbitrator records, else the robot's default.
+    """
+    from offline_evolution.maze_task.base import MazeTaskSettings
+
+    repertoire, rep_path, warnings = None, None, []
+    if arb.kind == "evorbc":
+        repertoire, rep_path, warnings = resolve_repertoire(
+            arb, arb_path, args.repertoire, args.allow_mismatch
+        )
+    for w in warnings:
+        print(f"evorbc-evolve: warning: {w}", file=sys.stderr)
+    recorded = arb.evolution.get("task")
+    if args.task:
+        settings = MazeTaskSettings.load(args.task)
+    elif recorded:
+        settings = MazeTaskSettings.from_dict(recorded, f"{arb_path}: evolution.task")
+    else:
+        settings = MazeTaskSettings.load(lookup(arb.robot).settings_file("task"))
+    return repertoire, rep_path, settings
+
+
+def check_task(task, arb, arb_path: Path, repertoire, rep_path, allow_mismatch: bool) -> None:
+    """Refuse a task whose simulated robot or sensor layout is not ``arb``'s.
+
+    The robot as :func:`check_design` compares it; the layout unless ``allow_mismatch``.
+    """
+    check_design(task.describe(), arb, arb_path, repertoire, rep_path)
+    try:
+        arb.check_sensors(task.layout, task.settings.sensors, allow_mismatch, WAIVER)
+    except ArbitratorError as e:
+        raise CliError(str(e)) from None
+
+
 def check_design(
     simulation: dict | None,
     arb: ArbitratorFile,
@@ -142,20 +180,8 @@ def cmd_replay(args: argparse.Namespace) -> int:
     arb = ArbitratorFile.load(arb_path)
     if args.heatmap and arb.kind != "evorbc":
         raise CliError("--heatmap needs an EvoRBC arbitrator (standard NEAT has no primitives)")
-    repertoire, rep_path, warnings = None, None, []
-    if arb.kind == "evorbc":
-        repertoire, rep_path, warnings = resolve_repertoire(
-            arb, arb_path, args.repertoire, args.allow_mismatch
-        )
-    for w in warnings:
-        print(f"evorbc-evolve: warning: {w}", file=sys.stderr)
+    repertoire, rep_path, settings = controller_inputs(arb, arb_path, args)
     recorded = arb.evolution.get("task")
-    if args.task:
-        settings = MazeTaskSettings.load(args.task)
-    elif recorded:
-        settings = MazeTaskSettings.from_dict(recorded, f"{arb_path}: evolution.task")
-    else:
-        settings = MazeTaskSettings.load(lookup(arb.robot).settings_file("task"))
     if args.maze != "all":
         settings = MazeTaskSettings((args.maze,), settings.episode_time, 1, settings.sensors)
     where = args.task or (f"{arb_path}: evolution.task" if recorded else "the default task")
@@ -169,11 +195,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
     )
     task = make_task(settings, arb.robot)
     try:
-        check_design(task.describe(), arb, arb_path, repertoire, rep_path)
-        try:
-            arb.check_sensors(task.layout, settings.sensors, args.allow_mismatch, WAIVER)
-        except ArbitratorError as e:
-            raise CliError(str(e)) from None
+        check_task(task, arb, arb_path, repertoire, rep_path, args.allow_mismatch)
         if args.start == "random":
             rng = np.random.default_rng(args.seed)
             starts = np.concatenate([task.sample_starts(rng) for _ in range(args.episodes)])

@@ -167,8 +167,14 @@ class MazeTaskBase(abc.ABC):
         """An EvoRBC controller (repertoire and mapping) or a standard one."""
 
     @abc.abstractmethod
-    def evaluate(self, networks: list, controller: Any, starts: np.ndarray, record: bool = False):
-        """Every network from every start row; episode ``i * len(starts) + j``."""
+    def evaluate(
+        self, networks: list, controller: Any, starts: np.ndarray, record: bool = False, world=None
+    ):
+        """Every network from every start row; episode ``i * len(starts) + j``.
+
+        ``world``: a :class:`~offline_evolution.maze_task.perturbation.WorldDraw` with one
+        row per start row (perturbed worlds, docs/design.md section 21), or None.
+        """
 
     @property
     def n_standard_outputs(self) -> int:

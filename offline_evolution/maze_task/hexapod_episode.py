@@ -17,11 +17,20 @@ primitive, as the executor's does.
 
 The ROS graph computes the same numbers from the same messages, so a lockstep run
 reproduces an episode cycle by cycle.
+
+A perturbed world (docs/design.md section 21) changes the ground's friction, the body's
+mass (and a payload at its centre), the servos' torque and speed for one episode and puts
+them back after it; delays primitives by whole cycles; and adds noise to the laser's beams
+and loses some (seeded by the episode's key). Nothing is changed for identity values.
 """
 
 from __future__ import annotations
 
+import collections
+import contextlib
+import dataclasses
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,6 +45,77 @@ from sim_bridge.hexapod.maze_world import FALLEN_TILT
 from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings
 from sim_bridge.hexapod.scanner import Scanner
 from sim_bridge.maze import Maze
+from sim_bridge.quiet_pybullet import p
+
+
+@contextlib.contextmanager
+def perturbed_sim(sim: HexapodSim, world: dict | None) -> Iterator[None]:
+    """Run the block with ``sim``'s friction, mass and servos as ``world`` draws them.
+
+    ``world``: one :meth:`~offline_evolution.maze_task.perturbation.WorldDraw.row` (factors
+    ``friction``, ``body_mass``, ``servo_strength``, ``servo_speed``; ``payload`` as a share
+    of the body's mass), or None. Only values other than the identity are touched, and the
+    nominal ones are put back afterwards (a saved state does not hold dynamics).
+    """
+    if not world:
+        yield
+        return
+    c = sim.client
+    friction = sim.physics.friction
+    info = p.getDynamicsInfo(sim.robot, -1, physicsClientId=c)
+    mass, inertia = info[0], info[2]  # kg and kg m^2 (principal axes) of the body
+    torques, settings = list(sim.torques), sim.settings
+    mass_factor = world["body_mass"] + world["payload"]
+    try:
+        if world["friction"] != 1.0:
+            # Contact friction is the product of both bodies' coefficients: scaling the
+            # ground's scales every foot contact.
+            p.changeDynamics(
+                sim.ground, -1, lateralFriction=friction * world["friction"], physicsClientId=c
+            )
+        if mass_factor != 1.0:
+            # The same shape, heavier: inertia scales with the mass.
+            p.changeDynamics(
+                sim.robot,
+                -1,
+                mass=mass * mass_factor,
+                localInertiaDiagonal=[i * mass_factor for i in inertia],
+                physicsClientId=c,
+            )
+        if world["servo_strength"] != 1.0:
+            sim.torques = [t * world["servo_strength"] for t in torques]
+        if world["servo_speed"] != 1.0:
+            servo = dataclasses.replace(
+                settings.servo, max_velocity=settings.servo.max_velocity * world["servo_speed"]
+            )
+            sim.settings = dataclasses.replace(settings, servo=servo)
+        yield
+    finally:
+        if world["friction"] != 1.0:
+            p.changeDynamics(sim.ground, -1, lateralFriction=friction, physicsClientId=c)
+        if mass_factor != 1.0:
+            p.changeDynamics(
+                sim.robot, -1, mass=mass, localInertiaDiagonal=inertia, physicsClientId=c
+            )
+        sim.torques, sim.settings = torques, settings
+
+
+def perturbed_ranges(
+    ranges: np.ndarray, world: dict | None, cycle: int, range_max: float
+) -> np.ndarray:
+    """Laser ``ranges`` (m) with the drawn noise (sd ``range_noise`` m) and dropouts.
+
+    A lost beam reads beyond ``range_max`` (no echo). Seeded by the world's key and the
+    cycle, so an episode's noise does not depend on the worker that runs it.
+    """
+    if not world or (world["range_noise"] <= 0.0 and world["dropout"] <= 0.0):
+        return ranges
+    rng = np.random.default_rng([world["key"], cycle])
+    noisy = np.asarray(ranges, dtype=np.float64) + world["range_noise"] * rng.standard_normal(
+        len(ranges)
+    )
+    lost = rng.random(len(ranges)) < world["dropout"]
+    return np.where(lost, math.inf, noisy)
 
 
 @dataclass(frozen=True)
@@ -118,15 +198,23 @@ class EpisodeRunner:
             self.sims[maze] = HexapodSim(w.geometry, w.physics, w.mazes[maze].boxes)
         return self.sims[maze]
 
-    def inputs(self, sim: HexapodSim, maze: Maze, base: tuple | None = None) -> np.ndarray:
+    def inputs(
+        self,
+        sim: HexapodSim,
+        maze: Maze,
+        base: tuple | None = None,
+        world: dict | None = None,
+        cycle: int = 0,
+    ) -> np.ndarray:
         """The arbitrator's inputs now: laser groups, then goal bearing.
 
         ``base``: the body's :meth:`~HexapodSim.base_pose` read since the last step, or
-        None to read it now.
+        None to read it now. ``world``, ``cycle``: a perturbed world's row and the cycle
+        (laser noise and dropouts, :func:`perturbed_ranges`).
         """
         base = sim.base_pose() if base is None else base
         s = self.scanner
-        ranges = s.scan(sim, base)
+        ranges = perturbed_ranges(s.scan(sim, base), world, cycle, s.range_max)
         rf = self.laser.readings(s.angle_min, s.angle_increment, ranges, s.range_min, s.range_max)
         (x, y, _), orn = base
         yaw = yaw_from_quaternion(*orn)
@@ -140,8 +228,11 @@ class EpisodeRunner:
         maze_index: int,
         start: tuple[float, float, float],
         record: bool = False,
+        world: dict | None = None,
     ) -> dict:
         """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index``.
+
+        ``world``: a perturbed world's row (:func:`perturbed_sim`), or None.
 
         Returns:
             ``{"reached", "fell", "cycles", "final_distance", "initial_distance"}`` and,
@@ -168,35 +259,40 @@ class EpisodeRunner:
         # primitive), the last gait run and the target held while none runs (rad).
         gait_start, last, last_row = None, None, None
         held = sim.joint_states()[0]  # before any primitive: where the joints stand
-        for cycle in range(self.world.n_cycles):
-            out = net.activate(self.inputs(sim, maze, base))
-            index, table, row = chooser.choose(out)
-            if table is not None:
-                if gait_start is None:
-                    gait_start = sim.steps_done
-                last, last_row = table, row
-                times = gait_step_times(sim.steps_done - gait_start, self.per_period, self.dt)
-                targets = table.joint_targets(times, np.repeat(row, len(times)))
-                held = None
-            else:
-                if held is None:  # the last gait's target at this cycle's first step
-                    now = gait_step_times(sim.steps_done - gait_start, 1, self.dt)
-                    held = last.joint_targets(now, last_row)[0]
-                targets = np.repeat(held[None, :], self.per_period, axis=0)
-            tilt, _ = sim.run(targets, max_tilt=FALLEN_TILT)
-            base = sim.base_pose()
-            x, y, heading, _ = sim.pose(base)
-            distance = math.hypot(x - tx, y - ty)
-            if record:
-                poses.append((x, y, heading))
-                choices.append(index)
-                outputs.append(out)
-            if distance <= maze.target_radius:
-                reached, cycles = True, cycle + 1
-                break
-            if tilt > FALLEN_TILT:
-                fell = True  # cycles stays n_cycles: eq. 5 scores where it lies
-                break
+        latency = int(world["latency_cycles"]) if world else 0
+        queue = collections.deque([(NO_PRIMITIVE, None, np.array([0]))] * latency)
+        with perturbed_sim(sim, world):
+            for cycle in range(self.world.n_cycles):
+                out = net.activate(self.inputs(sim, maze, base, world, cycle))
+                # Latency: the choice made ``latency`` cycles ago acts now (none before).
+                queue.append(chooser.choose(out))
+                index, table, row = queue.popleft()
+                if table is not None:
+                    if gait_start is None:
+                        gait_start = sim.steps_done
+                    last, last_row = table, row
+                    times = gait_step_times(sim.steps_done - gait_start, self.per_period, self.dt)
+                    targets = table.joint_targets(times, np.repeat(row, len(times)))
+                    held = None
+                else:
+                    if held is None:  # the last gait's target at this cycle's first step
+                        now = gait_step_times(sim.steps_done - gait_start, 1, self.dt)
+                        held = last.joint_targets(now, last_row)[0]
+                    targets = np.repeat(held[None, :], self.per_period, axis=0)
+                tilt, _ = sim.run(targets, max_tilt=FALLEN_TILT)
+                base = sim.base_pose()
+                x, y, heading, _ = sim.pose(base)
+                distance = math.hypot(x - tx, y - ty)
+                if record:
+                    poses.append((x, y, heading))
+                    choices.append(index)
+                    outputs.append(out)
+                if distance <= maze.target_radius:
+                    reached, cycles = True, cycle + 1
+                    break
+                if tilt > FALLEN_TILT:
+                    fell = True  # cycles stays n_cycles: eq. 5 scores where it lies
+                    break
         result = {
             "reached": reached,
             "fell": fell,

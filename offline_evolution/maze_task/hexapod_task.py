@@ -39,8 +39,8 @@ def _init_worker(world: HexapodWorld) -> None:
 
 
 def _run(runner: EpisodeRunner, job) -> dict:
-    network, controller, maze, start, record = job
-    return runner.run(NetworkSpec.from_dict(network), controller, maze, start, record)
+    network, controller, maze, start, record, world = job
+    return runner.run(NetworkSpec.from_dict(network), controller, maze, start, record, world)
 
 
 def _episode(job) -> dict:
@@ -49,6 +49,10 @@ def _episode(job) -> dict:
 
 class HexapodMazeTask(MazeTaskBase, SpawnedWorkers):
     """The maze task for the hexapod (``config/tasks/maze-hexapod.yaml``)."""
+
+    #: Its simulation's kind, for what a perturbation set can change (docs/design.md
+    #: section 21).
+    perturbation_family = "pybullet-legged"
 
     def __init__(
         self,
@@ -96,12 +100,18 @@ class HexapodMazeTask(MazeTaskBase, SpawnedWorkers):
         controller: HexapodController,
         starts: np.ndarray,
         record: bool = False,
+        world=None,
     ) -> EpisodeResult:
-        """Every network from every start row; episode ``i * len(starts) + j``."""
+        """Every network from every start row; episode ``i * len(starts) + j``.
+
+        ``world``: a :class:`~offline_evolution.maze_task.perturbation.WorldDraw` with one
+        row per start (its start errors already applied to ``starts``), or None.
+        """
+        rows = [world.row(k) if world is not None else None for k in range(len(starts))]
         jobs = [
-            (net.to_dict(), controller, int(row[0]), tuple(map(float, row[1:4])), record)
+            (net.to_dict(), controller, int(row[0]), tuple(map(float, row[1:4])), record, w)
             for net in networks
-            for row in starts
+            for row, w in zip(starts, rows, strict=True)
         ]
         results = self._map(jobs)
         reached = np.array([r["reached"] for r in results], dtype=bool)

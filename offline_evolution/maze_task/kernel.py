@@ -12,6 +12,12 @@ no primitive, as onboard (:func:`evorbc_ros.mapping.choose_primitive`, the execu
 message): zero wheel speed with the steering held at its last command.
 
 Episodes are independent, so results do not depend on the number of threads.
+
+A perturbed world (docs/design.md section 21, :mod:`~offline_evolution.maze_task.perturbation`)
+scales the commanded wheel speed, delays commands by whole cycles, adds noise to the
+rangefinder readings and loses some of them; the noise of each episode comes from its own
+key through a counter-based hash, so it does not depend on threads or on other episodes.
+With every factor 1 and every noise 0 the episode is the unperturbed one, bit for bit.
 """
 
 from __future__ import annotations
@@ -33,6 +39,31 @@ NO_PRIMITIVE = onboard_mapping.NO_PRIMITIVE
 
 #: Controller modes.
 EVORBC, STANDARD = 0, 1
+
+
+@nb.njit(cache=True)
+def _hash_uniform(key, cycle, index, salt):
+    """A uniform number in [0, 1) from ``(key, cycle, index, salt)`` (splitmix64's mixer)."""
+    z = np.uint64(key) + np.uint64(cycle * 1024 + index * 4 + salt + 1) * np.uint64(
+        0x9E3779B97F4A7C15
+    )
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    z = z ^ (z >> np.uint64(31))
+    return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@nb.njit(cache=True)
+def _perturb_readings(inputs, n_rangefinders, noise_sd, dropout, key, cycle):
+    """Rangefinder readings (in [0, 1], 0 = nothing in range) with noise and dropouts."""
+    for k in range(n_rangefinders):
+        if dropout > 0.0 and _hash_uniform(key, cycle, k, 0) < dropout:
+            inputs[k] = 0.0  # no echo: reads as nothing in range
+        elif noise_sd > 0.0 and inputs[k] > 0.0:
+            u1 = _hash_uniform(key, cycle, k, 1)
+            u2 = _hash_uniform(key, cycle, k, 2)
+            normal = math.sqrt(-2.0 * math.log(1.0 - u1)) * math.cos(2.0 * math.pi * u2)
+            inputs[k] = min(max(inputs[k] + noise_sd * normal, 0.0), 1.0)
 
 
 @nb.njit(cache=True)
@@ -79,6 +110,9 @@ def run_episodes(
     trace_pose,
     trace_choice,
     trace_outputs,
+    perturbed,
+    world_params,
+    noise_keys,
 ):
     """Run every episode ``e`` (genome ``genome[e]`` in maze ``maze[e]`` from ``start[e]``).
 
@@ -93,6 +127,9 @@ def run_episodes(
         lim: :class:`~sim_bridge.four_ws_motion.MotionLimits`.
         record: fill ``trace_pose (E, n_cycles + 1, 3)``, ``trace_choice (E, n_cycles)`` and
             ``trace_outputs (E, n_cycles, n_outputs)``; otherwise they may be 1-sized.
+        perturbed: apply ``world_params (E, 4)`` (wheel speed gain, latency in cycles,
+            reading noise sd, dropout probability) and ``noise_keys (E,)``; otherwise they
+            may be 1-sized and are not read.
 
     Returns:
         ``(reached (E,) bool, cycles (E,) int64, final_distance (E,), initial_distance (E,))``;
@@ -112,6 +149,7 @@ def run_episodes(
     lookup_origin, lookup_cell = controller.lookup_origin, controller.lookup_cell
     lookup_table, primitive_commands = controller.lookup_table, controller.primitive_commands
     gene_matrix, command_scale = controller.gene_matrix, controller.command_scale
+    n_rangefinders = sensors.ray_angles.shape[0]
     for e in nb.prange(n_ep):
         g = genome[e]
         m = maze[e]
@@ -127,6 +165,16 @@ def run_episodes(
         # does, which start at 0.
         command = np.zeros(5)
         before = np.empty(STATE_SIZE)
+        gain, latency, noise_sd, dropout, key = 1.0, 0, 0.0, 0.0, 0
+        if perturbed:
+            gain = world_params[e, 0]
+            latency = int(world_params[e, 1])
+            noise_sd = world_params[e, 2]
+            dropout = world_params[e, 3]
+            key = noise_keys[e]
+        # Commands still on their way to the wheels (latency): a ring of the last ones,
+        # starting as stops with the steering straight.
+        pending = np.zeros((max(latency, 1), 5))
         initial_distance[e] = math.hypot(start[e, 0] - tx, start[e, 1] - ty)
         dist = initial_distance[e]
         for t in range(n_cycles):
@@ -135,6 +183,8 @@ def run_episodes(
             h = state[e, HEADING]
             cand = _candidates(m, x, y, world)
             read_sensors(x, y, h, tx, ty, sensors, boxes, cand, inputs)
+            if noise_sd > 0.0 or dropout > 0.0:
+                _perturb_readings(inputs, n_rangefinders, noise_sd, dropout, key, t)
             activate(g, inputs, values, out, net)
             choice = -1
             finite = True
@@ -166,13 +216,22 @@ def run_episodes(
                     trace_outputs[e, t, k] = out[k]
             for k in range(STATE_SIZE):
                 before[k] = state[e, k]
-            step_robot(state, e, command, lim, boxes, cand)
+            if perturbed:
+                command[0] *= gain  # every branch above set the speed afresh this cycle
+            if latency > 0:
+                # Apply the command of ``latency`` cycles ago and queue this one.
+                slot = t % latency
+                applied = pending[slot].copy()
+                pending[slot, :] = command
+                step_robot(state, e, applied, lim, boxes, cand)
+            else:
+                step_robot(state, e, command, lim, boxes, cand)
             dist = math.hypot(state[e, X] - tx, state[e, Y] - ty)
             if dist <= target_radius[m]:
                 reached[e] = True
                 cycles[e] = t + 1
                 break
-            if not record:
+            if not record and not perturbed:
                 # A fixed point: the whole state (pose, speed, wheel angles) came back
                 # unchanged, so every later cycle reads the same sensors, gets the same
                 # outputs from the (stateless, feed-forward) network and makes the same

@@ -101,6 +101,10 @@ def standard_controller(robot: FourWSRobot) -> ControllerArrays:
 class MazeTask(MazeTaskBase):
     """The maze task for one 4WS robot: mazes, sensors and the compiled kernel."""
 
+    #: Its simulation's kind, for what a perturbation set can change (kinematic: no
+    #: friction, mass or servos; docs/design.md section 21).
+    perturbation_family = "kinematic-4ws"
+
     def __init__(self, settings: MazeTaskSettings, robot: str):
         self.robot = FourWSRobot(robot)
         super().__init__(settings, self.robot.control_period, self.robot.geometry.footprint_radius)
@@ -121,11 +125,14 @@ class MazeTask(MazeTaskBase):
         genomes: np.ndarray,
         starts: np.ndarray,
         record: bool = False,
+        world=None,
     ) -> EpisodeResult:
         """Run every genome index in ``genomes`` from every start row in ``starts``.
 
         Episodes are ordered genome-major: episode ``i * len(starts) + j`` is genome
-        ``genomes[i]`` from start ``j``.
+        ``genomes[i]`` from start ``j``. ``world``: a
+        :class:`~offline_evolution.maze_task.perturbation.WorldDraw` with one row per start
+        (its start errors already applied to ``starts``), or None for the nominal world.
         """
         genomes = np.asarray(genomes, dtype=np.int64)
         n_starts = len(starts)
@@ -139,6 +146,11 @@ class MazeTask(MazeTaskBase):
             pose = np.zeros((1, 1, 3))
             choice = np.zeros((1, 1), dtype=np.int64)
             outputs = np.zeros((1, 1, 1))
+        if world is not None:
+            params = np.tile(world.kernel_arrays(self.sensors.max_range), (len(genomes), 1))
+            keys = np.tile(world.keys, len(genomes))
+        else:
+            params, keys = np.ones((1, 4)), np.zeros(1, dtype=np.int64)
         with numba.parallel_chunksize(_CHUNK):
             reached, cycles, final, initial = run_episodes(
                 genome,
@@ -154,6 +166,9 @@ class MazeTask(MazeTaskBase):
                 pose,
                 choice,
                 outputs,
+                world is not None,
+                params,
+                keys,
             )
         traces = (pose, choice, outputs) if record else None
         return self.episode_result(reached, cycles, final, initial, traces)
@@ -174,13 +189,15 @@ class MazeTask(MazeTaskBase):
         controller: ControllerArrays,
         starts: np.ndarray,
         record: bool = False,
+        world=None,
     ) -> EpisodeResult:
         """Every network (:class:`~evorbc_ros.network.NetworkSpec`) from every start row.
 
-        Episode ``i * len(starts) + j`` is network ``i`` from start ``j``.
+        Episode ``i * len(starts) + j`` is network ``i`` from start ``j``; ``world``: see
+        :meth:`run`.
         """
         pack = pack_networks(networks)
-        return self.run(pack, controller, np.arange(len(networks)), starts, record)
+        return self.run(pack, controller, np.arange(len(networks)), starts, record, world)
 
     def close(self) -> None:
         """Nothing to release: the kernel runs in this process."""

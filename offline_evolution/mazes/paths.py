@@ -1,21 +1,27 @@
-"""Clearance-aware path search on a rasterised maze (a test helper, not part of the package).
+"""Clearance-aware path search on a rasterised maze (docs/design.md sections 4 and 21).
 
-The maze is sampled on a square grid of cell centres over ``Maze.bounds()``. A cell is free
-when its centre is at least ``margin`` m from every wall surface, so a robot of radius 0.05 m
-moving between free cells keeps ``margin - 0.05`` m of slack. Distances to the target are
-geodesic over the free cells with 8-connectivity (steps of ``cell`` and ``cell * sqrt(2)`` m),
-an upper bound on the true shortest length (by at most 8 %); :func:`taut_path` pulls the grid
-path straight to measure the length and the turns of the path a planner would take.
+Is a maze solvable for a robot, how long is the way, how narrow are its gaps.
 
-Run ``python tests/maze_paths.py`` to print the figures of every shipped maze.
+The maze generator (:mod:`offline_evolution.mazes.generator`) proves each maze it makes
+solvable with it, the held-out evaluation measures progress along it, and the shipped mazes'
+tests (``tests/test_mazes.py``) hold them to it.
+
+The maze is sampled on a square grid of cell centres over ``Maze.bounds()``. A cell is free when its
+centre is at least ``margin`` m from every wall surface, so a robot of radius 0.05 m (the defaults
+are the 4WS robot's) moving between free cells keeps ``margin - 0.05`` m of slack. Distances to the
+target are geodesic over the free cells with 8-connectivity (steps of ``cell`` and ``cell *
+sqrt(2)`` m), an upper bound on the true shortest length (by at most 8 %); :func:`taut_path` pulls
+the grid path straight to measure the length and the turns of the path a planner would take.
+
+Run ``python -m offline_evolution.mazes.paths`` to print the figures of every shipped maze.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
-import contourpy
 import numpy as np
 from scipy.ndimage import binary_dilation, label
 from scipy.sparse import coo_matrix
@@ -40,12 +46,35 @@ class Field:
     free: np.ndarray  # (ny, nx) bool
     distance: np.ndarray  # (ny, nx) geodesic distance to the target region, m (inf: cut off)
     towards: np.ndarray  # (ny, nx) flat index of the next cell towards the target (-1: none)
+    snap: float = SNAP  # m, how far a point may step to the nearest free cell
+
+    @cached_property
+    def snapped(self) -> np.ndarray:
+        """See :func:`snapped_distance`."""
+        from scipy.ndimage import grey_erosion
+
+        free_distance = np.where(self.free, self.distance, np.inf)
+        return grey_erosion(free_distance, footprint=_snap_disc(self))
+
+    def to_go(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Shortest path lengths (m) to the target from points ``(k,)`` (x, y in m).
+
+        Each point takes the cell it lies in and the best free cell within ``snap`` of it
+        (a robot may sit closer to a wall than the margin); inf where there is none. Cheap
+        for whole traces; :meth:`distance_from` measures one point exactly.
+        """
+        best = self.snapped
+        cell = self.xs[1] - self.xs[0]
+        i = np.rint((np.asarray(x) - self.xs[0]) / cell).astype(int)
+        j = np.rint((np.asarray(y) - self.ys[0]) / cell).astype(int)
+        i, j = np.clip(i, 0, len(self.xs) - 1), np.clip(j, 0, len(self.ys) - 1)
+        return best[j, i]
 
     def distance_from(self, x: float, y: float) -> float:
         """Shortest path length (m) from ``(x, y)`` to the target; inf if there is none."""
         gx, gy = np.meshgrid(self.xs, self.ys)
         step = np.hypot(gx - x, gy - y)
-        near = (step <= SNAP) & self.free
+        near = (step <= self.snap) & self.free
         if not near.any():
             return math.inf
         return float((self.distance[near] + step[near]).min())
@@ -54,7 +83,7 @@ class Field:
         """``(k, 2)`` cell centres of the shortest path from ``(x, y)`` to the target."""
         gx, gy = np.meshgrid(self.xs, self.ys)
         cost = np.where(self.free, self.distance + np.hypot(gx - x, gy - y), np.inf)
-        cost[np.hypot(gx - x, gy - y) > SNAP] = np.inf
+        cost[np.hypot(gx - x, gy - y) > self.snap] = np.inf
         node = int(np.argmin(cost))
         if not math.isfinite(cost.flat[node]):
             raise ValueError(f"no path from ({x}, {y})")
@@ -78,8 +107,17 @@ def clearance_grid(maze: Maze, cell: float = 0.01) -> tuple[np.ndarray, np.ndarr
     return xs, ys, near.reshape(gx.shape)
 
 
-def solve(maze: Maze, cell: float = 0.01, margin: float = MARGIN) -> Field:
-    """Free cells of ``maze`` and their geodesic distances to the target region."""
+def solve(maze: Maze, cell: float = 0.01, margin: float = MARGIN, snap: float = SNAP) -> Field:
+    """Free cells of ``maze`` and their geodesic distances to the target region.
+
+    Args:
+        cell: grid cell side, m.
+        margin: m, the clearance a free cell keeps from every wall surface (the robot's
+            footprint radius plus some slack).
+        snap: m, how far a start may step to the nearest free cell (see
+            :meth:`Field.distance_from`); the 4WS robot's starts keep its 0.05 m radius clear,
+            so 0.02 m takes them to the 0.06 m margin.
+    """
     xs, ys, clear = clearance_grid(maze, cell)
     ny, nx = clear.shape
     free = clear >= margin
@@ -106,11 +144,11 @@ def solve(maze: Maze, cell: float = 0.01, margin: float = MARGIN) -> Field:
     goal = free & (np.hypot(gx - maze.target[0], gy - maze.target[1]) <= maze.target_radius)
     if not goal.any():
         dist = np.full(free.shape, np.inf)
-        return Field(xs, ys, clear, free, dist, np.full(free.shape, -1))
+        return Field(xs, ys, clear, free, dist, np.full(free.shape, -1), snap)
     dist, pred, _ = dijkstra(
         graph, directed=False, indices=index[goal], min_only=True, return_predecessors=True
     )
-    return Field(xs, ys, clear, free, dist.reshape(ny, nx), pred.reshape(ny, nx))
+    return Field(xs, ys, clear, free, dist.reshape(ny, nx), pred.reshape(ny, nx), snap)
 
 
 def _visible(field: Field, a: np.ndarray, b: np.ndarray) -> bool:
@@ -165,10 +203,12 @@ def wall_followers(maze: Maze, keep: float = FOLLOW) -> dict[str, float]:
     """Path length (m) of a left- and a right-hand wall follower to the target.
 
     The follower keeps ``keep`` m from the wall surfaces, so it runs along the contour of the
-    clearance field at that level. It starts on the contour nearest the nominal start (the
-    outer boundary) and goes either way until it passes within ``target_radius`` of the
-    target; inf if it never does.
+    clearance field at that level (contourpy, a matplotlib dependency). It starts on the contour
+    nearest the nominal start (the outer boundary) and goes either way until it passes within
+    ``target_radius`` of the target; inf if it never does.
     """
+    import contourpy
+
     xs, ys, clear = clearance_grid(maze)
     lines = contourpy.contour_generator(xs, ys, clear).lines(keep)
     sx, sy = maze.start_pose[:2]
@@ -233,26 +273,53 @@ def narrowest_gap(maze: Maze, cell: float = 0.01, resolution: float = 0.001) -> 
     return 2.0 * lo
 
 
-def stranded_starts(maze: Maze, field: Field) -> int:
-    """Number of cells in the start region, clear of the robot, that cannot reach the target.
-
-    A start counts as reaching the target if a reachable free cell is within ``SNAP`` m,
-    as in :meth:`Field.distance_from`.
-    """
-    cell = field.xs[1] - field.xs[0]
-    r = int(SNAP / cell)
-    dj, di = np.mgrid[-r : r + 1, -r : r + 1]
-    disc = np.hypot(di, dj) * cell <= SNAP + 1e-9
-    near = binary_dilation(np.isfinite(field.distance), structure=disc)
+def start_cells(maze: Maze, field: Field, robot_radius: float = ROBOT_RADIUS) -> np.ndarray:
+    """``(ny, nx)`` bool: cells of the start region whose centre clears the robot."""
     gx, gy = np.meshgrid(field.xs, field.ys)
-    region = (
+    return (
         (maze.start_x[0] <= gx)
         & (gx <= maze.start_x[1])
         & (maze.start_y[0] <= gy)
         & (gy <= maze.start_y[1])
-        & (field.clearance >= ROBOT_RADIUS)
+        & (field.clearance >= robot_radius)
     )
-    return int((region & ~near).sum())
+
+
+def _snap_disc(field: Field) -> np.ndarray:
+    cell = field.xs[1] - field.xs[0]
+    r = int(field.snap / cell)
+    dj, di = np.mgrid[-r : r + 1, -r : r + 1]
+    return np.hypot(di, dj) * cell <= field.snap + 1e-9
+
+
+def stranded_starts(maze: Maze, field: Field, robot_radius: float = ROBOT_RADIUS) -> int:
+    """Number of cells in the start region, clear of the robot, that cannot reach the target.
+
+    A start counts as reaching the target if a reachable free cell is within ``field.snap``
+    m, as in :meth:`Field.distance_from`.
+    """
+    near = binary_dilation(np.isfinite(field.distance), structure=_snap_disc(field))
+    return int((start_cells(maze, field, robot_radius) & ~near).sum())
+
+
+def snapped_distance(field: Field) -> np.ndarray:
+    """``(ny, nx)`` distance (m) to the target from each cell, via the best free cell near it.
+
+    The best free cell within ``field.snap`` (a min filter over the snap disc); inf where
+    there is none. Computed once per field.
+    """
+    return field.snapped
+
+
+def longest_start_path(maze: Maze, field: Field, robot_radius: float = ROBOT_RADIUS) -> float:
+    """The longest shortest path (m) from any start cell that clears the robot.
+
+    Each start cell takes the best free cell within ``field.snap`` m, as
+    :meth:`Field.distance_from` does; inf if some start cannot reach the target.
+    """
+    best = snapped_distance(field)
+    region = start_cells(maze, field, robot_radius)
+    return float(best[region].max()) if region.any() else math.inf
 
 
 def backtrack(field: Field) -> float:

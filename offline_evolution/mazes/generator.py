@@ -1,0 +1,383 @@
+"""Seeded maze generator: new mazes of the size and kind of a robot's own, each proven solvable.
+
+A generated maze is an ordinary :class:`~sim_bridge.maze.Maze` (saved as a maze file, drawn
+by :mod:`sim_bridge.maze_plot`), made for one robot (docs/design.md section 21):
+
+* **Size and scale** come from the robot's registration: its default maze gives the inner
+  width and height, the start region (relative to the left wall), the target radius, the
+  narrowest gap (the narrow gaps here are 1.0-1.25 times it) and the shortest path (the
+  longest path allowed from any start is 1.1 times it, and at most 2/3 of what the robot
+  drives at its top speed in an episode); its footprint radius gives the margin every
+  path keeps from the walls (1.2 times the radius; 0.06 m for the 4WS robots, as in
+  ``tests/test_mazes.py``). For the 4WS robots that is an 11.1 x 1.39 m maze with
+  0.27-0.33 m gaps and at most 16 m of path; for the hexapod 8.0 x 2.0 m, about 1 m gaps,
+  at most 8.6 m.
+* **Obstacles**, left to right after the start zone, one per slot: ``baffle`` (from the top
+  or bottom wall, an opening at its tip), ``gap`` (a full-height wall with one narrow gap),
+  ``diagonal`` (a leaning baffle), ``posts`` (one to three short free-standing walls),
+  ``block`` (a closed box on a wall that forces a corridor around it), ``dead_end`` (a
+  baffle with a shelf back towards the start: a pocket open towards the robot) and
+  ``chamber`` (a wide open slot).
+* **Targets** anywhere reachable: ``wall`` (close to a wall of the last chamber, as in the
+  paper's mazes), ``open`` (far from every wall), ``behind`` (in the lee of the last
+  obstacle, behind a turn around its tip) or ``anywhere`` (any clear point of the maze's
+  right half, with obstacles beyond it).
+* **Proof.** A maze is kept only if at least :data:`MIN_OBSTACLES` obstacles (open
+  chambers not counted) lie before the target, and the clearance-aware path search
+  (:mod:`offline_evolution.mazes.paths`) connects every start cell that clears the robot
+  to the target, the longest such path is within the limit, and the narrowest gap on the
+  widest route is at least the design's narrowest (less two grid cells); otherwise the
+  draw is repeated from the same generator.
+
+Maze ``k`` of seed ``s`` is drawn from ``numpy.random.default_rng([s, k])``, so it does not
+depend on how many mazes are asked for: ``--count 10`` gives the first ten of ``--count 50``.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from evorbc_ros.config import ConfigError
+from sim_bridge.maze import Maze, load_named_maze, maze_from_dict
+
+from .paths import longest_start_path, narrowest_gap, solve, stranded_starts
+
+#: Obstacle kinds, and how often each is drawn.
+KINDS = ("baffle", "gap", "diagonal", "posts", "block", "dead_end", "chamber")
+_KIND_WEIGHTS = (0.22, 0.18, 0.14, 0.14, 0.12, 0.1, 0.1)
+#: Where targets go, and how often.
+TARGET_MODES = ("wall", "open", "behind", "anywhere")
+_TARGET_WEIGHTS = (0.3, 0.25, 0.25, 0.2)
+#: Draws per maze before giving up (a few in a hundred fail the proof).
+MAX_TRIES = 200
+#: Obstacles (not counting open chambers) that must lie before the target, so that no
+#: maze is nearly empty: the hexapod's own maze has three baffles.
+MIN_OBSTACLES = 3
+
+
+@dataclass(frozen=True)
+class MazeSpec:
+    """What a robot's generated mazes look like (all lengths in m, maze frame).
+
+    The inner free area is ``x in [-width/2, width/2]``, ``y in [-height/2, height/2]``;
+    built by :func:`spec_for_robot`.
+    """
+
+    robot: str
+    width: float
+    height: float
+    robot_radius: float  # footprint radius: starts keep it clear of walls
+    margin: float  # clearance a proving path keeps from every wall surface
+    narrow_gap: tuple[float, float]  # width of a gap in a full-height wall
+    opening: tuple[float, float]  # free width at a baffle's tip
+    spacing: tuple[float, float]  # between consecutive obstacles
+    start_offset: float  # start region's left edge, from the inner left wall
+    start_length: float  # start region's extent along x
+    start_inset: float  # start region's distance from the top and bottom walls
+    start_heading_deg: tuple[float, float]
+    first_obstacle: float  # nothing nearer the inner left wall than this
+    target_radius: float
+    path_limit: float  # longest shortest path from any start
+    cell: float = 0.01  # grid of the path search
+    wall_thickness: float = 0.01
+
+    @property
+    def snap(self) -> float:
+        """How far (m) a start may step to the nearest free cell (its clearance: the footprint)."""
+        return self.margin - self.robot_radius + 0.01
+
+
+@functools.lru_cache(maxsize=16)
+def spec_for_robot(name: str) -> MazeSpec:
+    """The generator's settings for a registered robot, from its registration.
+
+    Raises:
+        ConfigError: the robot is unknown (naming the known ones), or its default maze
+            is not solvable with its footprint (nothing to scale new mazes from).
+    """
+    from evorbc_ros.robots.registry import lookup
+
+    robot = lookup(name)
+    maze = load_named_maze(robot.maze)
+    r = robot.footprint_radius
+    margin = 1.2 * r
+    cell = 0.01 if maze.size()[1] < 1.8 else 0.02  # m; the hexapod's 2 m maze needs less
+    x0, y0, x1, y1 = maze.bounds()
+    t = maze.wall_thickness
+    inner_left, inner_h = x0 + t, (y1 - y0) - 2 * t
+    field_ = solve(maze, cell, margin, margin - r + 0.01)
+    path = field_.distance_from(*maze.start_pose[:2])
+    if not math.isfinite(path):
+        raise ConfigError(
+            f"robot {name}: its maze {robot.maze} has no path with {margin:.3f} m clearance; "
+            "cannot size generated mazes from it"
+        )
+    gap = narrowest_gap(maze, cell)
+    height = round(inner_h, 3)
+    return MazeSpec(
+        robot=name,
+        width=round((x1 - x0) - 2 * t, 3),
+        height=height,
+        robot_radius=r,
+        margin=margin,
+        narrow_gap=(gap, 1.25 * gap),
+        opening=(min(1.3 * gap, 0.55 * height), min(2.0 * gap, 0.6 * height)),
+        spacing=(max(0.6 * height, 1.2 * gap), max(1.1 * height, 2.0 * gap)),
+        start_offset=maze.start_x[0] - inner_left,
+        start_length=maze.start_x[1] - maze.start_x[0],
+        start_inset=max(0.0, min(maze.start_y[0] - (y0 + t), (y1 - t) - maze.start_y[1])),
+        start_heading_deg=tuple(math.degrees(h) for h in maze.start_heading),
+        first_obstacle=maze.start_x[1] - inner_left + max(margin, 0.2),
+        target_radius=maze.target_radius,
+        path_limit=min(1.1 * path, 2.0 / 3.0 * robot.max_speed * robot.episode_time),
+        cell=cell,
+        wall_thickness=t,
+    )
+
+
+@dataclass(frozen=True)
+class GeneratedMaze:
+    """A generated maze, what it holds and its proof figures."""
+
+    maze: Maze
+    kinds: tuple[str, ...]  # obstacle kinds, left to right
+    target_mode: str
+    longest_path: float  # m, the longest shortest path from a start cell
+    narrowest_gap: float  # m, on the widest route
+    tries: int = 1  # draws it took
+
+    def as_dict(self) -> dict:
+        """Plain-data summary (CLI output)."""
+        return {
+            "name": self.maze.name,
+            "kinds": list(self.kinds),
+            "target_mode": self.target_mode,
+            "longest_path": round(self.longest_path, 3),
+            "narrowest_gap": round(self.narrowest_gap, 3),
+        }
+
+
+@dataclass
+class _Draft:
+    """Walls (centre lines) and facts collected while a maze is drawn."""
+
+    spec: MazeSpec
+    walls: list = field(default_factory=list)
+    kinds: list = field(default_factory=list)
+    starts: list = field(default_factory=list)  # x (m) where each obstacle's slot begins
+    # (x of the obstacle's downstream face, side it hangs from: +1 top, -1 bottom)
+    last_face: tuple[float, int] | None = None
+
+    def wall(self, x1, y1, x2, y2) -> None:
+        self.walls.append([float(x1), float(y1), float(x2), float(y2)])
+
+
+def _edge(spec: MazeSpec, side: int) -> float:
+    """The y (m) of the top (+1) or bottom (-1) outer wall's centre line: walls start there."""
+    return side * (0.5 * spec.height + 0.5 * spec.wall_thickness)
+
+
+def _tip(spec: MazeSpec, side: int, opening: float) -> float:
+    """The y (m) of the tip of a baffle from ``side`` leaving ``opening`` m free at its tip."""
+    return side * (opening - 0.5 * spec.height)
+
+
+def _place(draft: _Draft, kind: str, a: float, b: float, rng: np.random.Generator) -> None:
+    """Draw an obstacle of ``kind`` into the slot ``[a, b]`` (m along x)."""
+    s, h = draft.spec, draft.spec.height
+    c = 0.5 * (a + b)
+    side = int(rng.choice((-1, 1)))
+    opening = rng.uniform(*s.opening)
+    if kind == "baffle":
+        draft.wall(c, _edge(s, side), c, _tip(s, side, opening))
+        draft.last_face = (c, side)
+    elif kind == "gap":
+        w = rng.uniform(*s.narrow_gap)
+        piece = 0.05 * h  # m, the shortest piece of wall left beside a gap
+        yc = rng.uniform(-0.5 * h + 0.5 * w + piece, 0.5 * h - 0.5 * w - piece)
+        draft.wall(c, _edge(s, 1), c, yc + 0.5 * w)
+        draft.wall(c, yc - 0.5 * w, c, _edge(s, -1))
+        # The lee of a gap wall: the side away from its gap.
+        draft.last_face = (c, -1 if yc > 0 else 1)
+    elif kind == "diagonal":
+        lean = rng.uniform(0.25, 0.45) * (b - a) * rng.choice((-1, 1))
+        draft.wall(c - lean, _edge(s, side), c + lean, _tip(s, side, opening))
+        draft.last_face = (max(c - lean, c + lean), side)
+    elif kind == "posts":
+        for _ in range(int(rng.integers(1, 4))):
+            length = rng.uniform(0.1, 0.3) * h
+            x = rng.uniform(a + 0.2 * (b - a), b - 0.2 * (b - a))
+            y = rng.uniform(-0.25 * h, 0.25 * h)
+            if rng.random() < 0.6:
+                draft.wall(x, y - 0.5 * length, x, y + 0.5 * length)
+            else:
+                draft.wall(x - 0.5 * length, y, x + 0.5 * length, y)
+        draft.last_face = None
+    elif kind == "block":
+        half = 0.5 * rng.uniform(0.3, 0.6) * (b - a)
+        y = _tip(s, side, opening)
+        draft.wall(c - half, _edge(s, side), c - half, y)
+        draft.wall(c - half, y, c + half, y)
+        draft.wall(c + half, y, c + half, _edge(s, side))
+        draft.last_face = (c + half, side)
+    elif kind == "dead_end":
+        # A baffle at the slot's right end and a shelf from its tip back towards the start:
+        # the pocket between the shelf and the wall is open towards the robot.
+        x = b - 0.15 * (b - a)
+        y = _tip(s, side, opening)
+        shelf = rng.uniform(0.4, 0.75) * (x - a)
+        draft.wall(x, _edge(s, side), x, y)
+        draft.wall(x, y, x - shelf, y)
+        draft.last_face = (x, side)
+    elif kind == "chamber":
+        draft.last_face = None
+    else:  # pragma: no cover - KINDS lists every kind
+        raise ValueError(kind)
+    draft.kinds.append(kind)
+    draft.starts.append(a)
+
+
+def _slot_length(kind: str, spec: MazeSpec, rng: np.random.Generator) -> float:
+    """Length (m, along x) ``kind`` takes, its share of free space around it included."""
+    base = rng.uniform(*spec.spacing)
+    if kind in ("block", "dead_end"):
+        return base * 1.5
+    if kind == "chamber":
+        return rng.uniform(1.0, 1.6) * spec.height
+    return base
+
+
+def _maze_data(draft: _Draft, name: str, target: tuple[float, float], note: str) -> dict:
+    s = draft.spec
+    hw, hh, t = 0.5 * s.width, 0.5 * s.height, s.wall_thickness
+    ox, oy = hw + 0.5 * t, hh + 0.5 * t
+    boundary = [[-ox, oy, ox, oy], [ox, oy, ox, -oy], [ox, -oy, -ox, -oy], [-ox, -oy, -ox, oy]]
+    boundary = [[round(v, 4) for v in w] for w in boundary]
+    x0 = -hw + s.start_offset
+    y0, y1 = -hh + s.start_inset, hh - s.start_inset
+    return {
+        "name": name,
+        "description": note,
+        "wall_thickness": t,
+        "walls": boundary + [[round(v, 4) for v in w] for w in draft.walls],
+        "start": {
+            "pose": [round(x0 + 0.5 * s.start_length, 4), 0.0, 0.0],
+            "region": {
+                "x": [round(x0, 4), round(x0 + s.start_length, 4)],
+                "y": [round(y0, 4), round(y1, 4)],
+                "heading_deg": list(s.start_heading_deg),
+            },
+        },
+        "target": [round(target[0], 4), round(target[1], 4)],
+        "target_radius": s.target_radius,
+    }
+
+
+def _clear_point(
+    maze: Maze, rng: np.random.Generator, x_range, clearance, tries: int = 400
+) -> tuple[float, float] | None:
+    """A point with ``x`` in ``x_range`` whose clearance lies in ``clearance`` (m), or None."""
+    hh = 0.5 * (maze.bounds()[3] - maze.bounds()[1])
+    for _ in range(tries):
+        x, y = rng.uniform(*x_range), rng.uniform(-hh, hh)
+        if clearance[0] <= maze.clearance(x, y) <= clearance[1]:
+            return x, y
+    return None
+
+
+def _target(draft: _Draft, mode: str, walls_maze: Maze, goal_from: float, rng) -> tuple | None:
+    """The target for ``mode``, or None if this draft has no room for one."""
+    s = draft.spec
+    hw, hh = 0.5 * s.width, 0.5 * s.height
+    near_wall = (1.5 * s.margin, 1.5 * s.margin + s.target_radius)  # m from a wall surface
+    if mode == "wall":
+        return _clear_point(walls_maze, rng, (goal_from, hw), near_wall)
+    if mode == "open":
+        return _clear_point(walls_maze, rng, (goal_from, hw), (0.3 * s.height, math.inf))
+    if mode == "behind":
+        if draft.last_face is None:
+            return None
+        x, side = draft.last_face
+        tx = x + rng.uniform(*near_wall)
+        ty = side * (hh - rng.uniform(near_wall[0], 0.35 * s.height))
+        if walls_maze.clearance(tx, ty) < near_wall[0]:
+            return None
+        return tx, ty
+    return _clear_point(walls_maze, rng, (0.0, hw), (near_wall[0], math.inf))
+
+
+def _draw(spec: MazeSpec, rng: np.random.Generator, name: str) -> tuple[dict, _Draft, str]:
+    """One draft maze (not yet proven)."""
+    hw = 0.5 * spec.width
+    draft = _Draft(spec)
+    x = -hw + spec.first_obstacle
+    goal_room = max(0.6 * spec.height, 2.0 * (spec.margin + spec.target_radius))
+    while True:
+        kind = str(rng.choice(KINDS, p=_KIND_WEIGHTS))
+        length = _slot_length(kind, spec, rng)
+        if x + length > hw - goal_room:
+            break
+        _place(draft, kind, x, x + length, rng)
+        x += length
+    mode = str(rng.choice(TARGET_MODES, p=_TARGET_WEIGHTS))
+    walls_only = maze_from_dict(_maze_data(draft, name, (hw - 0.5 * goal_room, 0.0), ""), name)
+    target = _target(draft, mode, walls_only, x + 0.5 * spec.margin, rng)
+    if target is None:
+        mode = "wall"
+        target = _target(draft, mode, walls_only, x + 0.5 * spec.margin, rng)
+    note = f"generated for {spec.robot}: {', '.join(draft.kinds) or 'no obstacles'}; target {mode}"
+    return _maze_data(draft, name, target or (hw - 0.5 * goal_room, 0.0), note), draft, mode
+
+
+def generate_maze(spec: MazeSpec, seed: int, index: int, prefix: str = "gen") -> GeneratedMaze:
+    """Maze ``index`` of ``seed`` for ``spec``, proven solvable (see the module docstring).
+
+    Raises:
+        RuntimeError: no draw in :data:`MAX_TRIES` passed the proof (a spec too tight).
+    """
+    rng = np.random.default_rng([seed, index])
+    name = f"{prefix}{seed}-{index:03d}"
+    for attempt in range(1, MAX_TRIES + 1):
+        data, draft, mode = _draw(spec, rng, name)
+        before = [
+            k for k, a in zip(draft.kinds, draft.starts, strict=True) if a < data["target"][0]
+        ]
+        if sum(k != "chamber" for k in before) < MIN_OBSTACLES:
+            continue  # too easy: draw again
+        try:
+            maze = maze_from_dict(data, name)
+        except ConfigError:
+            continue  # a target or start inside a wall: draw again
+        proof = prove(maze, spec)
+        if proof is not None:
+            return GeneratedMaze(maze, tuple(draft.kinds), mode, *proof, tries=attempt)
+    raise RuntimeError(f"no solvable maze for {spec.robot} in {MAX_TRIES} draws (seed {seed})")
+
+
+def prove(maze: Maze, spec: MazeSpec) -> tuple[float, float] | None:
+    """``(longest path m, narrowest gap m)`` if ``maze`` is solvable for ``spec``, else None.
+
+    Solvable: every start cell that clears the robot reaches the target keeping
+    ``spec.margin`` from the walls, within ``spec.path_limit``, and the widest route's
+    narrowest gap is at least the design's narrowest less two grid cells.
+    """
+    field_ = solve(maze, spec.cell, spec.margin, spec.snap)
+    if stranded_starts(maze, field_, spec.robot_radius):
+        return None
+    longest = longest_start_path(maze, field_, spec.robot_radius)
+    if not longest <= spec.path_limit:
+        return None
+    gap = narrowest_gap(maze, spec.cell)
+    if gap < spec.narrow_gap[0] - 2 * spec.cell:
+        return None
+    return longest, gap
+
+
+def generate_mazes(robot: str, count: int, seed: int, prefix: str = "gen") -> list[GeneratedMaze]:
+    """``count`` proven mazes for ``robot``: mazes ``0 .. count-1`` of ``seed``."""
+    spec = spec_for_robot(robot)
+    return [generate_maze(spec, seed, k, prefix) for k in range(count)]

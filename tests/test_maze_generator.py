@@ -1,0 +1,149 @@
+"""The maze generator: seeded, varied, and every maze solvable and loadable (issue 21).
+
+Solvability is checked again here, independently of the generator's own proof, with the
+clearance-aware path search the shipped mazes' tests use (``offline_evolution.mazes.paths``).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+
+import numpy as np
+import pytest
+
+from offline_evolution.cli import main
+from offline_evolution.mazes.files import save_maze
+from offline_evolution.mazes.generator import (
+    KINDS,
+    TARGET_MODES,
+    generate_maze,
+    generate_mazes,
+    spec_for_robot,
+)
+from offline_evolution.mazes.paths import MARGIN, ROBOT_RADIUS, solve, stranded_starts
+from sim_bridge.maze import load_maze
+
+SEEDS = (11, 12, 13)
+PER_SEED = 8
+
+
+@functools.cache
+def mazes(robot: str, seed: int, n: int = PER_SEED):
+    return generate_mazes(robot, n, seed)
+
+
+def test_same_seed_gives_the_same_mazes_and_other_seeds_differ():
+    first = [g.maze.to_dict() for g in mazes("4ws-5", SEEDS[0])]
+    again = [g.maze.to_dict() for g in generate_mazes("4ws-5", PER_SEED, SEEDS[0])]
+    other = [g.maze.to_dict() for g in mazes("4ws-5", SEEDS[1])]
+    assert first == again
+    assert all(a["walls"] != b["walls"] for a, b in zip(first, other, strict=True))
+    # Maze k does not depend on how many were asked for.
+    assert generate_maze(spec_for_robot("4ws-5"), SEEDS[0], 5).maze.to_dict() == first[5]
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_every_4ws_maze_is_solvable_from_its_whole_start_region(seed):
+    for g in mazes("4ws-5", seed):
+        maze = g.maze
+        width, height = maze.size()
+        assert 10.8 <= width <= 11.3 and 1.3 <= height <= 1.5
+        field = solve(maze)  # the 4WS margin of the shipped mazes' tests, 0.06 m
+        assert MARGIN == 0.06
+        assert field.distance_from(*maze.start_pose[:2]) <= 16.0
+        assert stranded_starts(maze, field, ROBOT_RADIUS) == 0
+        starts = maze.sample_starts(np.random.default_rng(0), 20, ROBOT_RADIUS)
+        assert max(field.distance_from(x, y) for x, y, _ in starts) <= 16.0
+
+
+def test_hexapod_mazes_have_its_size_and_are_solvable_for_its_footprint():
+    spec = spec_for_robot("hexapod")
+    for g in mazes("hexapod", 5, 4):
+        maze = g.maze
+        width, height = maze.size()
+        assert 7.8 <= width <= 8.2 and 1.9 <= height <= 2.1
+        field = solve(maze, spec.cell, spec.margin, spec.snap)
+        assert stranded_starts(maze, field, spec.robot_radius) == 0
+        assert field.distance_from(*maze.start_pose[:2]) <= spec.path_limit
+        assert g.kinds  # at least one obstacle in 8 m
+
+
+def test_a_generated_maze_saves_and_loads_as_an_ordinary_maze_file(tmp_path):
+    for g in mazes("4ws-5", SEEDS[0])[:3] + mazes("hexapod", 5, 4)[:1]:
+        path = tmp_path / f"{g.maze.name}.yaml"
+        save_maze(g.maze, path, "a header\nof two lines")
+        assert path.read_text().startswith("# a header\n# of two lines\n")
+        loaded = load_maze(path)
+        assert loaded.to_dict() == g.maze.to_dict()
+
+
+def test_obstacle_kinds_and_target_placements_all_appear():
+    made = [g for seed in SEEDS for g in mazes("4ws-5", seed)]
+    assert set().union(*(g.kinds for g in made)) == set(KINDS)
+    assert {g.target_mode for g in made} == set(TARGET_MODES)
+    # Not every target lies by a wall: some are far from every wall (open chambers).
+    clear = [g.maze.clearance(*g.maze.target) for g in made]
+    assert min(clear) < 0.3 and max(clear) > 0.45
+    # Not every target is at the far right end either.
+    assert min(g.maze.target[0] for g in made) < 4.0
+
+
+def test_a_target_behind_a_turn_cannot_be_seen_from_the_way_in():
+    made = [g for seed in SEEDS for g in mazes("4ws-5", seed) if g.target_mode == "behind"]
+    assert made
+    for g in made:
+        # The target hides in the lee of the last obstacle: the straight line from the
+        # start to it crosses a wall, and so does the line from a point 1 m before it.
+        maze = g.maze
+        tx, ty = maze.target
+        line = np.linspace((tx - 1.0, 0.0), (tx, ty), 200)
+        assert maze.clearances(line[:, 0], line[:, 1]).min() < 0.006
+
+
+def test_mazes_command_writes_files_and_a_picture(tmp_path, capsys):
+    out = tmp_path / "suite"
+    assert (
+        main(["mazes", "--robot", "4ws-5", "--count", "3", "--seed", "11", "--out", str(out)]) == 0
+    )
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["gen11-000.yaml", "gen11-001.yaml", "gen11-002.yaml", "mazes.png"]
+    assert (out / "mazes.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    for k, g in enumerate(mazes("4ws-5", 11)[:3]):
+        assert load_maze(out / f"gen11-00{k}.yaml").to_dict() == g.maze.to_dict()
+    capsys.readouterr()
+    assert (
+        main(
+            ["mazes", "--count", "1", "--seed", "11", "--out", str(out), "--json", "--plot", "none"]
+        )
+        == 0
+    )
+    assert json.loads(capsys.readouterr().out)["mazes"][0]["name"] == "gen11-000"
+
+
+def test_mazes_command_refuses_a_file_as_its_folder(tmp_path, capsys):
+    path = tmp_path / "taken"
+    path.write_text("x")
+    assert main(["mazes", "--count", "1", "--out", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "--out" in err and "expected a folder" in err and len(err.strip().splitlines()) == 1
+
+
+def test_any_registered_robot_gets_mazes_sized_from_its_registration(monkeypatch):
+    import dataclasses
+
+    from evorbc_ros.robots import registry
+
+    monkeypatch.setattr(registry, "_registry", registry.Registry())
+    wide = dataclasses.replace(
+        registry.lookup("4ws-5"), name="wide-4ws", footprint_radius=0.08, maze="gaps"
+    )
+    registry.register(wide)
+    spec = spec_for_robot("wide-4ws")
+    assert spec.margin == pytest.approx(0.096) and spec.robot_radius == 0.08
+    assert spec.narrow_gap[0] == pytest.approx(0.28, abs=0.011)  # gaps' narrowest gap
+    for k in range(3):
+        maze = generate_maze(spec, 2, k).maze
+        field = solve(maze, spec.cell, spec.margin, spec.snap)
+        assert stranded_starts(maze, field, 0.08) == 0
+        assert field.distance_from(*maze.start_pose[:2]) <= spec.path_limit
