@@ -118,6 +118,17 @@ def test_its_repertoire_records_its_body_and_the_paper_robots_record_none(user_r
     paper = generate_repertoire(load_settings(robot="4ws-5", **tiny))
     assert "simulation" not in paper.algorithm  # files of the paper's robots are unchanged
 
+    # The same robot's file edited afterwards: its old repertoire is refused for the task.
+    from evorbc_ros.repertoire import RepertoireError
+    from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
+    from sim_bridge.robots.design import check_simulation
+
+    big_4ws(user_robots, max_speed=0.35)
+    registry.reset()
+    task = MazeTask(MazeTaskSettings(("gaps",), 15.0), "big-4ws")
+    with pytest.raises(RepertoireError, match=r"evolved for a different robot .*max_speed"):
+        check_simulation(mine, task.describe())
+
 
 HEAD = "kind: four_ws\ntype: 4ws-5\n"
 
