@@ -7,6 +7,8 @@ hot paths. This script measures, in fresh processes whose imports come from each
 
 * 4WS primitives: evaluations/s of ``make_robot("4ws-5").evaluate_primitives`` (100k
   primitives of 2 s), MAP-Elites' hot path;
+* 4WS MAP-Elites: evaluations/s of a Table I run cut to 200 iterations (10k + 200 x 1000
+  evaluations; batches of 1000, where the per-batch cost counts);
 * 4WS episodes: control cycles/s of one arbitrator generation (150 NEAT networks, 5 mazes,
   120 s, the shipped repertoire, EvoRBC polar mapping), the compiled episode kernel;
 * hexapod primitives: evaluations/s of 2 s gaits in PyBullet on one worker;
@@ -35,6 +37,7 @@ from pathlib import Path
 
 FIGURES = {
     "4ws_primitives": "4WS primitives (evaluations/s)",
+    "4ws_repertoire": "4WS MAP-Elites, batches of 1000 (evaluations/s)",
     "4ws_episodes": "4WS episode kernel (control cycles/s)",
     "hexapod_primitives": "hexapod primitives (evaluations/s, 1 worker)",
     "hexapod_episodes": "hexapod episode (control cycles/s, 1 worker)",
@@ -64,6 +67,14 @@ def measure(wanted: set[str]) -> dict:
         robot = make_robot("4ws-5")
         genes = rng.uniform(-1, 1, (100_000, 5))
         out["4ws_primitives"] = best_rate(lambda: robot.evaluate_primitives(genes, 2.0), 1e5, 5)
+    if "4ws_repertoire" in wanted:
+        from offline_evolution.repertoire.map_elites import generate_repertoire
+        from offline_evolution.repertoire.settings import load_settings
+
+        settings = load_settings(robot="4ws-5", seed=1, iterations=200)
+        out["4ws_repertoire"] = best_rate(
+            lambda: generate_repertoire(settings), settings.evaluations, 2
+        )
     if "4ws_episodes" in wanted:
         out["4ws_episodes"] = four_ws_episodes()
     if "hexapod_primitives" in wanted:
