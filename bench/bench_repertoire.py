@@ -1,13 +1,15 @@
-"""Benchmark: MAP-Elites repertoire generation for the 4WS robots (issue: Table I budget).
+"""Benchmark: MAP-Elites repertoire generation for the kinematic robots (Table I budget).
 
-Prints, for this machine:
-  * the full Table I run for 4ws-5 (10k + 1000 x 1000 = 1.01M evaluations of 2 s):
+Prints, for this machine and ``--robot`` (4ws-5, or any compiled-path robot such as
+turtlebot3-burger, the differential-drive robot from config/robots/):
+  * the full Table I run (10k + 1000 x 1000 = 1.01M evaluations of 2 s):
     wall time, evaluations per second and peak memory (max RSS of the process);
   * where the time goes (evaluation, archive insertion, mutation, metric);
   * how the throughput grows with the batch size and the run time with the number of
     evaluations.
 
-Run: ``.venv/bin/python bench/bench_repertoire.py`` (``--quick`` for a short version).
+Run: ``.venv/bin/python bench/bench_repertoire.py`` (``--quick`` for a short version,
+``--robot turtlebot3-burger`` for the differential-drive robot).
 """
 
 from __future__ import annotations
@@ -40,8 +42,12 @@ def machine() -> str:
     )
 
 
+#: The robot measured (``--robot``).
+ROBOT = "4ws-5"
+
+
 def timed_run(**overrides) -> tuple[float, object]:
-    settings = load_settings(robot=overrides.pop("robot", "4ws-5"), **overrides)
+    settings = load_settings(robot=overrides.pop("robot", ROBOT), **overrides)
     start = time.perf_counter()
     rep = generate_repertoire(settings)
     return time.perf_counter() - start, rep
@@ -82,7 +88,7 @@ def cold_cli_run() -> float:
             "offline_evolution.cli",
             "repertoire",
             "--robot",
-            "4ws-5",
+            ROBOT,
             "--seed",
             "1",
             "--out",
@@ -98,16 +104,19 @@ def cold_cli_run() -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="skip the scaling sweeps")
+    parser.add_argument("--robot", default="4ws-5", help="robot measured (default: 4ws-5)")
     args = parser.parse_args()
+    global ROBOT
+    ROBOT = args.robot
     print(f"machine: {machine()}")
     timed_run(iterations=2)  # compile / load the JIT cache outside the measurements
 
-    full = load_settings(robot="4ws-5", seed=1)
+    full = load_settings(robot=ROBOT, seed=1)
     wall, rep = timed_run(seed=1)
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     s = rep.summary()
     print(
-        f"\nfull Table I run, 4ws-5: {full.evaluations:,} evaluations of {full.eval_time:g} s "
+        f"\nfull Table I run, {ROBOT}: {full.evaluations:,} evaluations of {full.eval_time:g} s "
         f"in {wall:.2f} s = {full.evaluations / wall / 1e3:.0f}k evaluations/s "
         f"({full.evaluations * full.eval_time / 0.1 / wall / 1e6:.1f}M robot steps/s); "
         f"{s['count']} primitives, mean quality {s['mean_quality']:.3f}"

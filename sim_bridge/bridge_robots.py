@@ -1,5 +1,7 @@
 """The robot-specific half of the simulation bridge: a 4WS robot or the hexapod.
 
+A differential-drive robot's is :mod:`sim_bridge.diff_drive_bridge`.
+
 Each adapter owns its simulated world, subscribes its command topics, fills the joint
 states and laser scan, and steps the world with the commands of the cycle. The bridge node
 (:mod:`sim_bridge.bridge_node`) runs the loop, clock, odometry and result the same way for
@@ -17,7 +19,13 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from evorbc_ros.nodes.common import RELIABLE, StartupError, declare, finite_parameter
+from evorbc_ros.nodes.common import (
+    RELIABLE,
+    StartupError,
+    declare,
+    finite_parameter,
+    robot_named,
+)
 from evorbc_ros.robots.four_ws import WHEEL_NAMES
 from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES
 from evorbc_ros.robots.registry import RobotError
@@ -39,7 +47,37 @@ class ScanGeometry:
     range_max: float
 
 
-class FourWSBridge:
+class KinematicBridge:
+    """What the kinematic robots' adapters share: the laser, the scan and a planar pose."""
+
+    def _laser(self, node) -> LaserConfig:
+        """The simulated scanner from the node's parameters; sets :attr:`scan_geometry`."""
+        laser = LaserConfig(
+            beams=declare(node, "laser_beams", 360, "laser beams per scan"),
+            range_max=finite_parameter(node, "laser_range", 2.0, "laser range (m)", positive=True),
+        )
+        if laser.beams < 1:
+            raise StartupError("parameter laser_beams must be at least 1")
+        self.scan_geometry = ScanGeometry(
+            laser.angle_min,
+            laser.angle_min + laser.increment * (laser.beams - 1),
+            laser.increment,
+            laser.range_min,
+            laser.range_max,
+        )
+        return laser
+
+    def scan(self) -> np.ndarray:
+        """Laser ranges (m)."""
+        return self.world.scan()
+
+    def body_pose(self) -> tuple[tuple, tuple]:
+        """Position (m) and orientation (xyzw) of ``base_link`` in ``odom``: planar."""
+        x, y, h = self.world.pose
+        return (x, y, 0.0), (0.0, 0.0, math.sin(0.5 * h), math.cos(0.5 * h))
+
+
+class FourWSBridge(KinematicBridge):
     """A 4WS robot: steering angles and wheel velocities in, kinematic motion model."""
 
     #: Command topics the lockstep loop waits for each cycle (parameter names).
@@ -48,14 +86,13 @@ class FourWSBridge:
     def __init__(self, node, robot: str, maze, pose, episode_time: float, gui: bool) -> None:
         self.node = node
         self.wheel_radius = finite_parameter(
-            node, "wheel_radius", 0.02, "wheel radius (m)", positive=True
+            node,
+            "wheel_radius",
+            robot_named(robot).node_default("wheel_radius", 0.02),
+            "wheel radius (m)",
+            positive=True,
         )
-        laser = LaserConfig(
-            beams=declare(node, "laser_beams", 360, "laser beams per scan"),
-            range_max=finite_parameter(node, "laser_range", 2.0, "laser range (m)", positive=True),
-        )
-        if laser.beams < 1:
-            raise StartupError("parameter laser_beams must be at least 1")
+        laser = self._laser(node)
         self.topics = {
             "steering": declare(
                 node,
@@ -69,13 +106,6 @@ class FourWSBridge:
         }
         self.world = SimWorld(maze, robot, pose, episode_time, laser, gui)
         self.commands: dict[str, np.ndarray | None] = {"steering": None, "wheel": None}
-        self.scan_geometry = ScanGeometry(
-            laser.angle_min,
-            laser.angle_min + laser.increment * (laser.beams - 1),
-            laser.increment,
-            laser.range_min,
-            laser.range_max,
-        )
 
     @property
     def name(self) -> str:
@@ -116,18 +146,9 @@ class FourWSBridge:
         """One control period with the latest commands."""
         self.world.step(self.wheel_command(), self.wheel_radius)
 
-    def scan(self) -> np.ndarray:
-        """Laser ranges (m)."""
-        return self.world.scan()
-
     def twist(self) -> tuple[float, float]:
         """Forward speed (m/s) and yaw rate (rad/s) in the body frame."""
         return self.world.speed, 0.0
-
-    def body_pose(self) -> tuple[tuple, tuple]:
-        """Position (m) and orientation (xyzw) of ``base_link`` in ``odom``: planar."""
-        x, y, h = self.world.pose
-        return (x, y, 0.0), (0.0, 0.0, math.sin(0.5 * h), math.cos(0.5 * h))
 
     def joint_state(self, msg: JointState) -> None:
         """Fill the joint names, positions and velocities."""
@@ -252,8 +273,6 @@ def bridge_robot_class(robot: str) -> type:
         StartupError: an unknown robot (listing the known ones), or an adapter that cannot
             be imported.
     """
-    from evorbc_ros.nodes.common import robot_named
-
     try:
         return robot_named(robot).load("bridge")
     except RobotError as e:

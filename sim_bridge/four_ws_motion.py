@@ -17,7 +17,6 @@ import math
 from typing import NamedTuple
 
 import numba as nb
-import numpy as np
 
 from evorbc_ros.robots.four_ws import FourWSGeometry
 from sim_bridge.geometry import clearance
@@ -259,13 +258,12 @@ def step_robot(state, i, command, lim, boxes, candidates):
     return abs(distance)
 
 
-@nb.njit(cache=True, parallel=True)
 def run_primitives(commands, n_steps, lim):
-    """Execute primitives from rest at the origin facing +x, in free space.
+    """Execute 4WS primitives from rest at the origin facing +x, in free space.
 
     Each row of ``commands`` is held constant for ``n_steps`` control steps; rate limits
-    apply throughout (docs/design.md section 2). Robots are independent, so the result does not
-    depend on the number of threads.
+    apply throughout (docs/design.md section 2). The compiled loop is every kinematic
+    robot's (:func:`sim_bridge.kinematics.run_model_primitives`).
 
     Args:
         commands: ``(n, 5)`` wheel commands.
@@ -276,17 +274,6 @@ def run_primitives(commands, n_steps, lim):
         ``(n, 4)`` rows ``(x m, y m, final heading rad (unwrapped), path length m)``.
 
     """
-    n = commands.shape[0]
-    out = np.empty((n, 4))
-    state = np.zeros((n, STATE_SIZE))
-    no_boxes = np.empty((0, 6))
-    no_candidates = np.empty(0, dtype=np.int64)
-    for i in nb.prange(n):
-        path = 0.0
-        for _ in range(n_steps):
-            path += step_robot(state, i, commands[i], lim, no_boxes, no_candidates)
-        out[i, 0] = state[i, X]
-        out[i, 1] = state[i, Y]
-        out[i, 2] = state[i, HEADING]
-        out[i, 3] = path
-    return out
+    from sim_bridge.kinematics import run_model_primitives  # it imports this module
+
+    return run_model_primitives(commands, n_steps, lim)

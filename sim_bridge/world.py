@@ -77,7 +77,11 @@ class EpisodeStatus:
 
 
 class SimWorld:
-    """A 4WS robot in a maze, stepped by wheel commands."""
+    """A 4WS robot in a maze, stepped by wheel commands.
+
+    :class:`~sim_bridge.diff_drive_world.DiffDriveWorld` changes the motion model only
+    (:meth:`_model`, :meth:`_move`, :meth:`_roll_wheels`).
+    """
 
     def __init__(
         self,
@@ -90,21 +94,36 @@ class SimWorld:
         geometry: FourWSGeometry | None = None,
     ) -> None:
         self.maze = maze
-        self.type = robot_type(robot)
-        self.geometry = geometry or FourWSGeometry()
-        self.limits = motion_limits(self.geometry)
+        self._model(robot, geometry)
         self.laser = laser
         self.episode_time = episode_time
         self.physics = PyBulletMaze(maze, self.geometry.footprint_radius, gui=gui)
-        self.state = np.zeros((1, STATE_SIZE))
+        self.state = np.zeros((1, self.state_size))
         self.state[0, :3] = maze.start_pose if start is None else start
         self.time = 0.0
         self.cycles = 0
-        self.wheel_angle = np.zeros(4)  # rad, integrated wheel rotation (joint states)
+        # rad, integrated rotation of each wheel (joint states)
+        self.wheel_angle = np.zeros(self.n_wheels)
         tx, ty = maze.target
         self.initial_distance = math.hypot(self.state[0, X] - tx, self.state[0, Y] - ty)
         self.reached = False
         self.physics.show_pose(*self.pose)
+
+    def _model(self, robot: str, geometry) -> None:
+        """The robot's motion model: its type, geometry and limits (4WS here)."""
+        self.type = robot_type(robot)
+        self.geometry = geometry or self.type.body()
+        self.limits = motion_limits(self.geometry)
+        self.state_size = STATE_SIZE
+        self.n_wheels = 4
+
+    def _move(self, command: np.ndarray) -> float:
+        """One control step of the motion model, no walls; the distance moved (m)."""
+        return step_robot(self.state, 0, command, self.limits, _NO_BOXES, _NO_CANDIDATES)
+
+    def _roll_wheels(self, wheel_radius: float) -> None:
+        """Integrate the wheels' rotation (rad) over the step: one speed for all four."""
+        self.wheel_angle += self.state[0, SPEED] * self.limits.dt / wheel_radius
 
     @property
     def dt(self) -> float:
@@ -127,24 +146,20 @@ class SimWorld:
         return float(self.state[0, SPEED])
 
     def step(self, command: np.ndarray, wheel_radius: float = 0.02) -> float:
-        """Apply a ``(speed, fl, fr, rl, rr)`` command for one control period.
+        """Apply a command for one control period.
+
+        The command is ``(speed, fl, fr, rl, rr)`` for a 4WS robot; ``wheel_radius`` (m)
+        turns its speed into wheel rotation.
 
         Returns:
             Distance travelled (m); 0 if the wheels fought or a wall was in the way.
         """
         x0, y0 = self.state[0, X], self.state[0, Y]
-        moved = step_robot(
-            self.state,
-            0,
-            np.asarray(command, dtype=np.float64),
-            self.limits,
-            _NO_BOXES,
-            _NO_CANDIDATES,
-        )
+        moved = self._move(np.asarray(command, dtype=np.float64))
         if moved > 0.0 and not self.physics.footprint_clear(self.state[0, X], self.state[0, Y]):
             self.state[0, X], self.state[0, Y] = x0, y0
             moved = 0.0
-        self.wheel_angle += self.state[0, SPEED] * self.limits.dt / wheel_radius
+        self._roll_wheels(wheel_radius)
         self.cycles += 1
         self.time = self.cycles * self.limits.dt
         tx, ty = self.maze.target

@@ -11,7 +11,9 @@ from evorbc_ros.robots import registry
 from evorbc_ros.robots.registry import Registry, RobotError, UnknownRobot
 
 BUILTIN = ("2ws-2", "2ws-3", "4ws-3", "4ws-5", "hexapod")
-KNOWN = "known robots: 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod"
+#: Robots declared in config/robots/ settings files (after the built-in ones).
+FROM_FILES = ("turtlebot3-burger",)
+KNOWN = "known robots: 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod, turtlebot3-burger"
 
 
 def test_the_builtin_robots_are_each_declared_once_and_completely():
@@ -20,8 +22,8 @@ def test_the_builtin_robots_are_each_declared_once_and_completely():
     from offline_evolution.maze_task.task import MazeTaskSettings
     from offline_evolution.repertoire.settings import load_settings
 
-    assert registry.names() == BUILTIN
-    for name in BUILTIN:
+    assert registry.names() == BUILTIN + FROM_FILES
+    for name in BUILTIN + FROM_FILES:
         robot = registry.lookup(name)
         assert load_settings(robot=name).robot == name
         run = load_run_settings(robot=name)
@@ -33,8 +35,15 @@ def test_the_builtin_robots_are_each_declared_once_and_completely():
         assert robot.sensors_file() == config_dir() / task.sensors
         if robot.shipped_arbitrator:
             assert default_arbitrator(name).is_file() and default_repertoire(name).is_file()
-    equal = {n: registry.lookup(n).equal_budget_generations for n in BUILTIN}
-    assert equal == {"2ws-2": 25, "2ws-3": 25, "4ws-3": 25, "4ws-5": 25, "hexapod": 455}
+    equal = {n: registry.lookup(n).equal_budget_generations for n in BUILTIN + FROM_FILES}
+    assert equal == {
+        "2ws-2": 25,
+        "2ws-3": 25,
+        "4ws-3": 25,
+        "4ws-5": 25,
+        "hexapod": 455,
+        "turtlebot3-burger": 25,
+    }
     assert [r.name for r in registry.robots() if r.shipped_arbitrator] == ["4ws-5", "hexapod"]
 
 
@@ -77,7 +86,8 @@ def test_an_unknown_robot_in_a_settings_file_is_named_with_its_key(tmp_path):
     with pytest.raises(ConfigError) as info:
         load_settings(path)
     assert str(info.value) == (
-        f"{path}: robot must be one of 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod; got 'tank'"
+        f"{path}: robot must be one of 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod, turtlebot3-burger; "
+        "got 'tank'"
     )
 
 
@@ -128,7 +138,8 @@ def test_plugins_are_looked_for_only_when_a_name_is_not_built_in(monkeypatch):
     assert calls == []  # built-in names never scan the installed packages
     assert reg.lookup("one").name == "one"
     assert calls == ["evorbc.robots"]
-    assert reg.names() == (*BUILTIN, "one") and calls == ["evorbc.robots"]  # scanned once
+    # scanned once
+    assert reg.names() == (*BUILTIN, *FROM_FILES, "one") and calls == ["evorbc.robots"]
 
 
 def test_every_kind_of_plugin_and_every_broken_one(monkeypatch):
@@ -146,7 +157,7 @@ def test_every_kind_of_plugin_and_every_broken_one(monkeypatch):
     ]
     reg, _, reported = fake_registry(monkeypatch, points)
     # Entry points are read in name order, so the listing does not depend on install order.
-    assert reg.names() == (*BUILTIN, "fine", "left", "right", "single")
+    assert reg.names() == (*BUILTIN, *FROM_FILES, "fine", "left", "right", "single")
     assert reported == reg.problems
     assert reported == [
         "robot plugin clash (fake_clash:robots): robot hexapod is already registered; left out",
@@ -191,4 +202,5 @@ def test_looking_up_a_robot_onboard_loads_no_simulation_or_search_code():
 def test_the_names_are_live_choices():
     assert "hexapod" in registry.ROBOT_NAMES and "tank" not in registry.ROBOT_NAMES
     assert 5 not in registry.ROBOT_NAMES
-    assert list(registry.ROBOT_NAMES) == list(BUILTIN) and len(registry.ROBOT_NAMES) == 5
+    assert list(registry.ROBOT_NAMES) == [*BUILTIN, *FROM_FILES]
+    assert len(registry.ROBOT_NAMES) == 6

@@ -70,7 +70,7 @@ class PrimitiveExecutorNode(Node):
             self.wheel_radius = finite_parameter(
                 self,
                 "wheel_radius",
-                0.02,
+                spec.node_default("wheel_radius", 0.02),
                 "wheel radius (m), for wheel velocities; applied live",
                 positive=True,
                 live=True,

@@ -12,7 +12,7 @@ from std_msgs.msg import Float64MultiArray
 
 from evorbc_ros.executor import PrimitiveExecutor, WheelCommand
 from evorbc_ros.nodes.common import RELIABLE, vector_message
-from evorbc_ros.robots.four_ws import WHEEL_NAMES, FourWSGeometry
+from evorbc_ros.robots.four_ws import WHEEL_NAMES
 
 
 class WheelCommands:
@@ -21,7 +21,8 @@ class WheelCommands:
     Args:
         node: the ``primitive_executor`` node; its parameters ``steering_topic``,
             ``wheel_topic`` and (read at every command) ``wheel_radius`` are used.
-        robot: the robot's registration; its ``model`` is its ``FourWSType``.
+        robot: the robot's registration; its ``model`` is its ``FourWSType`` (gene
+            layout and body).
         inputs: sensor topics whose silence stops the robot.
         stale_timeout: s, inputs older than this stop the robot.
 
@@ -29,7 +30,7 @@ class WheelCommands:
 
     def __init__(self, node, robot, inputs: list[str], stale_timeout: float) -> None:
         self.node = node
-        self.logic = PrimitiveExecutor(robot.model, FourWSGeometry(), inputs, stale_timeout)
+        self.logic = PrimitiveExecutor(robot.model, robot.model.body(), inputs, stale_timeout)
         self.steering_pub = node.create_publisher(
             Float64MultiArray, node.get_parameter("steering_topic").value, RELIABLE
         )

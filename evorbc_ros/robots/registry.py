@@ -13,6 +13,12 @@ Where robots come from:
 
 * **Built in**: the modules in :data:`BUILTIN_MODULES` (the four 4WS types and the
   hexapod), each with a module-level ``ROBOTS`` tuple, imported on the first look-up.
+* **Settings files**: YAML files with a ``kind`` key in ``config/robots/`` and in the
+  folders of ``$EVORBC_ROBOT_PATH`` (:mod:`evorbc_ros.robots.settings_robots`): a robot
+  declared without Python (a differential-drive robot, a 4WS robot of other dimensions).
+  Read when a name is not built in, or when every name is needed. A file that does not
+  load is reported once per process in one line naming the file and the key, and left
+  out; looking its robot up raises that line.
 * **Plugins**: third-party packages declare entry points in the group ``evorbc.robots``
   (:data:`PLUGIN_GROUP`). Each one gives a :class:`Robot`, or a callable returning one or
   an iterable of them. They are discovered lazily: only when a name is not built in, or
@@ -123,6 +129,10 @@ class Robot:
             bridge simulates (the hexapod's geometry, physics and laser).
         model: the robot's own definition, for its factories (a 4WS robot: its
             ``FourWSType``); evorbc never reads it.
+        node_defaults: ``(parameter, value)`` pairs: the robot's own defaults for the
+            executor's and the bridge's parameters (a 4WS robot's ``wheel_radius``, m),
+            used where no parameter file or ``--ros-args`` sets them.
+        source: the settings file it was declared in ("" for one declared in Python).
 
     """
 
@@ -146,6 +156,8 @@ class Robot:
     shipped_arbitrator: str = ""
     design_check: str = ""
     model: Any = None
+    node_defaults: tuple[tuple[str, Any], ...] = ()
+    source: str = ""
 
     @property
     def n_parameters(self) -> int:
@@ -156,6 +168,10 @@ class Robot:
     def parameter_names(self) -> tuple[str, ...]:
         """The parameters' names, as the arbitrator labels a primitive's genes."""
         return tuple(p.name for p in self.parameters)
+
+    def node_default(self, parameter: str, fallback: Any) -> Any:
+        """The robot's default for a node parameter, or ``fallback`` if it gives none."""
+        return dict(self.node_defaults).get(parameter, fallback)
 
     def settings_file(self, kind: str) -> Path:
         """The default settings file of ``kind`` (repertoire, arbitrator, neat or task)."""
@@ -292,7 +308,11 @@ class Registry:
         self.report = report
         self._robots: dict[str, Robot] = {}
         self._builtin_done = False
+        self._files_done = False
         self._plugins_done = False
+        #: The one-line problem of each robot settings file that failed, by its stem.
+        self.file_problems: dict[str, str] = {}
+        self._files_failed = 0
         #: One line per plugin or registration that could not be used.
         self.problems: list[str] = []
 
@@ -304,11 +324,28 @@ class Registry:
             for robot in importlib.import_module(module).ROBOTS:
                 self.register(robot)
 
+    def _settings_files(self) -> None:
+        if self._files_done:
+            return
+        self._files_done = True
+        self._builtins()
+        from evorbc_ros.robots.settings_robots import read_robot_file, robot_files
+
+        for path in robot_files():
+            try:
+                robot = read_robot_file(path)
+                if robot is not None:
+                    self.register(robot)
+            except ConfigError as e:  # RobotError too: an invalid or taken name
+                self.file_problems.setdefault(path.stem, str(e))
+                self._files_failed += 1
+                self._problem(f"robot file {e}; left out")
+
     def _plugins(self) -> None:
         if self._plugins_done:
             return
         self._plugins_done = True
-        self._builtins()
+        self._settings_files()
         from importlib.metadata import entry_points
 
         for point in sorted(entry_points(group=self.group), key=lambda p: p.name):
@@ -353,8 +390,13 @@ class Registry:
         """
         if self.known(name):
             return self._robots[name]
+        if isinstance(name, str) and name in self.file_problems:
+            raise RobotError(f"robot {name}: {self.file_problems[name]}")
         known = ", ".join(self.names())
-        broken = f" ({len(self.problems)} robot plugin(s) failed to load)" if self.problems else ""
+        plugins = len(self.problems) - self._files_failed
+        broken = f" ({plugins} robot plugin(s) failed to load)" if plugins else ""
+        if self._files_failed:
+            broken += f" ({self._files_failed} robot file(s) failed to load)"
         raise UnknownRobot(f"unknown robot {name!r}; known robots: {known}{broken}")
 
     def known(self, name: Any) -> bool:
@@ -363,11 +405,17 @@ class Registry:
             return False
         self._builtins()
         if name not in self._robots:
+            self._settings_files()
+        if name not in self._robots:
             self._plugins()
         return name in self._robots
 
     def names(self) -> tuple[str, ...]:
-        """Every robot's name: built-in ones first, then plugins' (by entry-point name)."""
+        """Every robot's name.
+
+        Built-in ones first, then settings files' (by folder, then file name), then
+        plugins' (by entry-point name).
+        """
         self._plugins()
         return tuple(self._robots)
 

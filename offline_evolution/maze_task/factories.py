@@ -8,11 +8,18 @@ Each is called ``task(robot, settings, workers=None)`` with the robot's registra
 from __future__ import annotations
 
 
-def four_ws_task(robot, settings, workers: int | None = None):
-    """The compiled maze task of a 4WS robot (its episodes run on numba's threads)."""
+def kinematic_task(robot, settings, workers: int | None = None):
+    """The compiled maze task of a kinematic robot, 4WS or differential drive.
+
+    Its episodes run on numba's threads, in the robot's own motion model.
+    """
     from offline_evolution.maze_task.task import MazeTask
 
-    return MazeTask(settings, robot.name)
+    return MazeTask(settings, robot.make_simulation())
+
+
+#: The name 4WS registrations made before differential-drive robots used.
+four_ws_task = kinematic_task
 
 
 def hexapod_task(robot, settings, workers: int | None = None):

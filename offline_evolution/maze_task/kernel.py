@@ -1,15 +1,17 @@
 """The compiled episode kernel: many (controller, maze, start) episodes in one parallel loop.
 
 Each control cycle (0.1 s) of an episode: read the sensors at the robot's pose, evaluate the
-controller's network, turn its outputs into a wheel command, and step the 4WS motion model
-(with wall contact). An EvoRBC controller maps its two outputs to a behaviour-space point and
-runs the nearest primitive (grid lookup); a standard-NEAT controller's outputs are the
-robot's genes. The episode ends when the robot's centre is within the target radius or
-after ``n_cycles`` cycles.
+controller's network, turn its outputs into a command, and step the robot's motion model
+(with wall contact): the 4WS model or the differential-drive one, chosen at compile time by
+the type of the limits (:mod:`sim_bridge.kinematics`). An EvoRBC controller maps its two
+outputs to a behaviour-space point and runs the nearest primitive (grid lookup); a
+standard-NEAT controller's outputs are the robot's genes. The episode ends when the
+robot's centre is within the target radius or after ``n_cycles`` cycles.
 
 A cycle whose network outputs are not finite (or, for EvoRBC, map to no finite point) runs
 no primitive, as onboard (:func:`evorbc_ros.mapping.choose_primitive`, the executor's empty
-message): zero wheel speed with the steering held at its last command.
+message): zero wheel speed with the steering held at its last command (4WS), a zero twist
+(differential drive).
 
 Episodes are independent, so results do not depend on the number of threads.
 
@@ -29,8 +31,9 @@ import numpy as np
 
 from evorbc_ros import mapping as onboard_mapping
 from offline_evolution.arbitrator.compiled import activate
-from sim_bridge.four_ws_motion import HEADING, STATE_SIZE, X, Y, step_robot
+from sim_bridge.four_ws_motion import HEADING, STATE_SIZE, X, Y
 from sim_bridge.geometry import grid_candidates
+from sim_bridge.kinematics import halt, step_model
 from sim_bridge.sensors import read_sensors
 
 map_point = nb.njit(cache=True)(onboard_mapping.map_point)
@@ -124,7 +127,9 @@ def run_episodes(
         world: :class:`~offline_evolution.maze_task.world.MazePack`.
         sensors: :class:`~sim_bridge.sensors.CompiledLayout`.
         controller: :class:`~offline_evolution.maze_task.task.ControllerArrays`.
-        lim: :class:`~sim_bridge.four_ws_motion.MotionLimits`.
+        lim: the robot's limits: :class:`~sim_bridge.four_ws_motion.MotionLimits` or
+            :class:`~sim_bridge.diff_drive_motion.DiffLimits` (its state fits in
+            ``STATE_SIZE`` columns, x, y and heading first).
         record: fill ``trace_pose (E, n_cycles + 1, 3)``, ``trace_choice (E, n_cycles)`` and
             ``trace_outputs (E, n_cycles, n_outputs)``; otherwise they may be 1-sized.
         perturbed: apply ``world_params (E, 4)`` (wheel speed gain, latency in cycles,
@@ -150,6 +155,8 @@ def run_episodes(
     lookup_table, primitive_commands = controller.lookup_table, controller.primitive_commands
     gene_matrix, command_scale = controller.gene_matrix, controller.command_scale
     n_rangefinders = sensors.ray_angles.shape[0]
+    # Entries of a command: the robot's (4WS 5, differential drive 2).
+    width = primitive_commands.shape[1] if mode == EVORBC else gene_matrix.shape[1]
     for e in nb.prange(n_ep):
         g = genome[e]
         m = maze[e]
@@ -161,9 +168,9 @@ def run_episodes(
         inputs = np.empty(sensors.n_inputs)
         values = np.empty(max_slots)
         out = np.empty(n_outputs)
-        # (speed m/s, 4 steering angles rad); a stop keeps the last angles, as the executor
-        # does, which start at 0.
-        command = np.zeros(5)
+        # 4WS: (speed m/s, 4 steering angles rad); a stop keeps the last angles, as the
+        # executor does, which start at 0. Differential drive: (v m/s, omega rad/s).
+        command = np.zeros(width)
         before = np.empty(STATE_SIZE)
         gain, latency, noise_sd, dropout, key = 1.0, 0, 0.0, 0.0, 0
         if perturbed:
@@ -174,7 +181,7 @@ def run_episodes(
             key = noise_keys[e]
         # Commands still on their way to the wheels (latency): a ring of the last ones,
         # starting as stops with the steering straight.
-        pending = np.zeros((max(latency, 1), 5))
+        pending = np.zeros((max(latency, 1), width))
         initial_distance[e] = math.hypot(start[e, 0] - tx, start[e, 1] - ty)
         dist = initial_distance[e]
         for t in range(n_cycles):
@@ -195,10 +202,10 @@ def run_episodes(
                 finite = math.isfinite(px) and math.isfinite(py)
                 if finite:
                     choice = _lookup(px, py, lookup_origin, lookup_cell, lookup_table)
-                    for c in range(5):
+                    for c in range(width):
                         command[c] = primitive_commands[choice, c]
             elif finite:
-                for c in range(5):
+                for c in range(width):
                     acc = 0.0
                     for k in range(n_outputs):
                         gene = 2.0 * min(max(out[k], 0.0), 1.0) - 1.0
@@ -206,7 +213,7 @@ def run_episodes(
                     command[c] = acc * command_scale[c]
             if not finite:
                 choice = NO_PRIMITIVE
-                command[0] = 0.0  # no primitive: stop, steering held
+                halt(command, lim)  # no primitive: stop
             if record:
                 trace_pose[e, t, 0] = x
                 trace_pose[e, t, 1] = y
@@ -217,15 +224,20 @@ def run_episodes(
             for k in range(STATE_SIZE):
                 before[k] = state[e, k]
             if perturbed:
-                command[0] *= gain  # every branch above set the speed afresh this cycle
+                # Every branch above set the speeds afresh this cycle. A wheel speed gain
+                # scales the 4WS speed, and both v and omega of a differential drive
+                # (every wheel turns faster by the same factor).
+                command[0] *= gain
+                if width == 2:
+                    command[1] *= gain
             if latency > 0:
                 # Apply the command of ``latency`` cycles ago and queue this one.
                 slot = t % latency
                 applied = pending[slot].copy()
                 pending[slot, :] = command
-                step_robot(state, e, applied, lim, boxes, cand)
+                step_model(state, e, applied, lim, boxes, cand)
             else:
-                step_robot(state, e, command, lim, boxes, cand)
+                step_model(state, e, command, lim, boxes, cand)
             dist = math.hypot(state[e, X] - tx, state[e, Y] - ty)
             if dist <= target_radius[m]:
                 reached[e] = True

@@ -43,7 +43,7 @@ QUANTITIES = {
 }
 #: What each robot family's simulation applies (the rest it cannot model).
 APPLIES = {
-    "kinematic-4ws": (
+    "kinematic": (
         "wheel_speed_gain",
         "latency_cycles",
         "range_noise",

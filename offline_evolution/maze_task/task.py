@@ -1,4 +1,6 @@
-"""The maze task of the 4WS robots: controllers as arrays and the compiled episode kernel.
+"""The maze task of the kinematic robots: controllers as arrays and the compiled kernel.
+
+The kinematic robots are the 4WS ones and the differential-drive ones.
 
 Settings, mazes, start poses and eq. 5 fitness are every maze task's
 (:mod:`offline_evolution.maze_task.base`); episodes run in one parallel compiled kernel
@@ -25,8 +27,12 @@ from offline_evolution.maze_task.base import (
 from offline_evolution.maze_task.kernel import EVORBC, STANDARD, run_episodes
 from offline_evolution.maze_task.world import pack_mazes
 from offline_evolution.task_protocol import EpisodeResult
+from sim_bridge.robots.diff_drive import DiffDriveRobot
 from sim_bridge.robots.four_ws import FourWSRobot
 from sim_bridge.sensors import compile_layout
+
+#: A robot whose compiled motion model the episode kernel runs.
+KinematicRobot = FourWSRobot | DiffDriveRobot
 
 #: Episodes handed to a worker thread at a time: small enough to balance episodes that end
 #: early (target reached) against ones that run the full 120 s.
@@ -47,7 +53,11 @@ __all__ = [
 
 
 class ControllerArrays(NamedTuple):
-    """How network outputs become wheel commands, as arrays for the kernel."""
+    """How network outputs become commands, as arrays for the kernel.
+
+    A command has ``w`` entries, the robot's (a 4WS robot: speed and four angles, 5; a
+    differential-drive robot: linear and angular speed, 2).
+    """
 
     mode: int
     map_kind: int
@@ -56,18 +66,19 @@ class ControllerArrays(NamedTuple):
     lookup_origin: np.ndarray  # (2,)
     lookup_cell: np.ndarray  # (2,)
     lookup_table: np.ndarray  # (nx, ny) int64
-    primitive_commands: np.ndarray  # (n_primitives, 5)
-    gene_matrix: np.ndarray  # (n_genes, 5)
-    command_scale: np.ndarray  # (5,)
+    primitive_commands: np.ndarray  # (n_primitives, w)
+    gene_matrix: np.ndarray  # (n_genes, w)
+    command_scale: np.ndarray  # (w,)
 
 
 def evorbc_controller(
-    repertoire: Repertoire, mapping: str, robot: FourWSRobot, grid_cells: int = 256
+    repertoire: Repertoire, mapping: str, robot: KinematicRobot, grid_cells: int = 256
 ) -> ControllerArrays:
     """Arrays of an EvoRBC controller: mapping, lookup grid and each primitive's command."""
     fn = MappingFunction.for_behaviours(mapping, repertoire.behaviour)
     lookup = PrimitiveLookup.build(repertoire.behaviour, fn.domain(), grid_cells)
-    commands = robot.type.commands(repertoire.genes, robot.geometry)
+    commands = robot.commands(repertoire.genes)
+    width = len(robot.command_scale)
     return ControllerArrays(
         EVORBC,
         fn.kind,
@@ -76,15 +87,14 @@ def evorbc_controller(
         np.array(lookup.cell),
         lookup.table,
         np.ascontiguousarray(commands),
-        np.zeros((1, 5)),
-        np.zeros(5),
+        np.zeros((1, width)),
+        np.zeros(width),
     )
 
 
-def standard_controller(robot: FourWSRobot) -> ControllerArrays:
+def standard_controller(robot: KinematicRobot) -> ControllerArrays:
     """Arrays of a standard-NEAT controller: outputs are the robot's genes."""
-    g = robot.geometry
-    scale = np.array([g.max_speed] + [g.max_wheel_angle] * 4)
+    width = len(robot.command_scale)
     return ControllerArrays(
         STANDARD,
         0,
@@ -92,22 +102,35 @@ def standard_controller(robot: FourWSRobot) -> ControllerArrays:
         np.zeros(2),
         np.ones(2),
         np.zeros((1, 1), dtype=np.int64),
-        np.zeros((1, 5)),
-        np.ascontiguousarray(robot.type.gene_matrix),
-        scale,
+        np.zeros((1, width)),
+        np.ascontiguousarray(robot.gene_matrix, dtype=np.float64),
+        np.asarray(robot.command_scale, dtype=np.float64),
     )
 
 
 class MazeTask(MazeTaskBase):
-    """The maze task for one 4WS robot: mazes, sensors and the compiled kernel."""
+    """The maze task for one kinematic robot: mazes, sensors and the compiled kernel.
+
+    Args:
+        settings: the task.
+        robot: a registered robot's name, or its simulated robot (a
+            :class:`~sim_bridge.robots.four_ws.FourWSRobot` or
+            :class:`~sim_bridge.robots.diff_drive.DiffDriveRobot`: their compiled motion
+            model runs in the kernel).
+
+    """
 
     #: Its simulation's kind, for what a perturbation set can change (kinematic: no
     #: friction, mass or servos; docs/design.md section 21).
-    perturbation_family = "kinematic-4ws"
+    perturbation_family = "kinematic"
 
-    def __init__(self, settings: MazeTaskSettings, robot: str):
-        self.robot = FourWSRobot(robot)
-        super().__init__(settings, self.robot.control_period, self.robot.geometry.footprint_radius)
+    def __init__(self, settings: MazeTaskSettings, robot: str | KinematicRobot):
+        if isinstance(robot, str):
+            from evorbc_ros.robots.registry import lookup
+
+            robot = lookup(robot).make_simulation()
+        self.robot = robot
+        super().__init__(settings, robot.control_period, robot.footprint_radius)
         self.sensors = compile_layout(self.layout)
         # Walls a ray or the footprint can touch from a cell: sensor reach plus a step and
         # a margin (m).
@@ -198,6 +221,10 @@ class MazeTask(MazeTaskBase):
         """
         pack = pack_networks(networks)
         return self.run(pack, controller, np.arange(len(networks)), starts, record, world)
+
+    def describe(self) -> dict | None:
+        """The robot's design as files record it (None: the paper's 4WS body)."""
+        return self.robot.describe()
 
     def close(self) -> None:
         """Nothing to release: the kernel runs in this process."""

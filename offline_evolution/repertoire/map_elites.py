@@ -329,7 +329,10 @@ class MapElites:
 
     def _simulation(self) -> dict:
         describe = getattr(self.robot, "describe", None)
-        return {"simulation": describe()} if describe is not None else {}
+        design = describe() if describe is not None else None
+        # A robot with nothing to record (the paper's 4WS body) adds no key: its files
+        # stay as they were.
+        return {"simulation": design} if design is not None else {}
 
     def _own_evaluation(self) -> dict:
         """What only a run with the caller's evaluation records (its stated reach)."""

@@ -16,9 +16,29 @@ class FourWSRobot:
     def __init__(self, type_name: str, geometry: FourWSGeometry | None = None) -> None:
         self.type: FourWSType = robot_type(type_name)
         self.name = self.type.name
-        self.geometry = geometry or FourWSGeometry()
+        self.geometry = geometry or self.type.body()
         self.limits = motion_limits(self.geometry)
         self.control_period = self.geometry.control_period
+        self.footprint_radius = self.geometry.footprint_radius
+        #: How a standard controller's outputs become commands: ``(n_genes, 5)`` weights and
+        #: the ``(5,)`` command limits (m/s, rad) they scale to.
+        self.gene_matrix = self.type.gene_matrix
+        g = self.geometry
+        self.command_scale = np.array([g.max_speed] + [g.max_wheel_angle] * 4)
+
+    def commands(self, genes: np.ndarray) -> np.ndarray:
+        """``(n, 5)`` wheel commands (speed m/s, fl, fr, rl, rr rad) of ``(n, d)`` genes."""
+        return self.type.commands(genes, self.geometry)
+
+    def describe(self) -> dict | None:
+        """Its body, as files record a design.
+
+        None for the paper's body (files made before the geometry came from a settings
+        file record none), else the geometry (SI units).
+        """
+        if self.geometry == FourWSGeometry():
+            return None
+        return {"kinematics": "four_ws", "geometry": self.geometry.as_dict()}
 
     @property
     def parameter_specs(self) -> tuple[ParameterSpec, ...]:

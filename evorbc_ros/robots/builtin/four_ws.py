@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from evorbc_ros.robots.four_ws import ROBOT_TYPES, FourWSGeometry, FourWSType
+from evorbc_ros.robots.four_ws import ROBOT_TYPES, FourWSType
 from evorbc_ros.robots.registry import Robot, SettingsFiles
 
 #: Topics the 4WS command interface publishes: ros2_control forward command controllers.
@@ -32,23 +32,23 @@ DESCRIPTIONS = {
 
 
 def four_ws_robot(robot_type: FourWSType, description: str = "", **changes) -> Robot:
-    """The registration of a 4WS robot type on the paper's body (docs/design.md section 2).
+    """The registration of a 4WS robot type (docs/design.md section 2).
 
     Args:
-        robot_type: its genes and how they drive the five wheel commands; its name is the
-            robot's name.
+        robot_type: its genes and how they drive the five wheel commands, on its body
+            (``robot_type.geometry``, the paper's if None); its name is the robot's name.
         description: one line for listings (default: the gene names).
         changes: fields to set otherwise (settings files, maze, shipped controller, ...).
 
     """
-    geometry = FourWSGeometry()
+    geometry = robot_type.body()
     robot = Robot(
         name=robot_type.name,
         description=description or f"4WS robot with genes {', '.join(robot_type.parameter_names)}",
         parameters=robot_type.parameter_specs(geometry),
         settings=SETTINGS,
         simulation="sim_bridge.robots.four_ws:simulated_robot",
-        task="offline_evolution.maze_task.factories:four_ws_task",
+        task="offline_evolution.maze_task.factories:kinematic_task",
         bridge="sim_bridge.bridge_robots:FourWSBridge",
         commands="evorbc_ros.nodes.wheel_commands:WheelCommands",
         command_topics=COMMAND_TOPICS,
@@ -64,6 +64,7 @@ def four_ws_robot(robot_type: FourWSType, description: str = "", **changes) -> R
         # (docs/performance.md), rounded up.
         episode_bytes=400,
         model=robot_type,
+        node_defaults=(("wheel_radius", geometry.wheel_radius),),
     )
     return dataclasses.replace(robot, **changes) if changes else robot
 

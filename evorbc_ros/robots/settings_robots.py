@@ -1,0 +1,194 @@
+"""Robots declared in settings files only: ``kind:`` plus the robot's figures, no Python.
+
+A robot settings file is a YAML file with a ``kind`` key in ``config/robots/`` (shipped)
+or in a folder named by ``$EVORBC_ROBOT_PATH`` (the user's; folders separated by
+``os.pathsep``, as ``PATH``). The registry reads them after its built-in robots and
+before plugins (docs/design.md section 19, docs/your-robot.md). A YAML file there without
+``kind`` is not a robot declaration (``4ws.yaml``, the paper's 4WS body; the legged
+robots' URDF settings) and is left alone.
+
+Kinds (:data:`KINDS`): ``four_ws``, one of the paper's 4WS gene layouts on a body of the
+file's dimensions, and ``diff_drive``, a differential-drive robot. Keys every kind takes:
+
+* ``kind``, ``name`` (default: the file's stem), ``description``;
+* ``settings``: ``repertoire``, ``arbitrator``, ``neat``, ``task`` files, and ``sensors``,
+  each beside this file if found there, else relative to evorbc's ``config/``;
+* ``maze``, ``episode_time`` (s), ``equal_budget_generations``;
+* ``geometry``: the kind's body and limits (:class:`~evorbc_ros.robots.four_ws.FourWSGeometry`
+  keys for ``four_ws``, which keep the paper's value for a key not given;
+  :class:`~evorbc_ros.robots.diff_drive.DiffDriveGeometry` keys, all required, for
+  ``diff_drive``).
+
+This module depends on numpy and PyYAML only (docs/design.md section 17).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
+from evorbc_ros.robots.registry import Robot, SettingsFiles
+
+#: The environment variable naming the user's folders of robot settings files.
+PATH_VARIABLE = "EVORBC_ROBOT_PATH"
+#: The kinds a robot settings file may declare.
+KINDS = ("four_ws", "diff_drive")
+
+
+@dataclass(frozen=True)
+class RobotFileKeys:
+    """The top-level keys of a robot settings file (``geometry`` is the kind's)."""
+
+    kind: str = setting(doc="what the robot is", choices=KINDS)
+    name: str | None = setting(None, doc="the robot's name (default: the file's stem)")
+    description: str = setting("", doc="one line for listings")
+    type: str | None = setting(None, doc="four_ws: the paper's gene layout it uses")
+    # Mappings, checked by the kind (geometry) and by _SettingsKeys (settings).
+    geometry: Any = None
+    settings: Any = None
+    sensors: str | None = setting(None, doc="sensor layout file")
+    maze: str | None = setting(None, doc="the maze it runs in when none is named")
+    episode_time: float | None = setting(None, doc="s, T of eq. 5 there", minimum=0.1)
+    equal_budget_generations: int | None = setting(None, doc="standard --equal-budget", minimum=0)
+
+
+@dataclass(frozen=True)
+class _SettingsKeys:
+    repertoire: str | None = setting(None)
+    arbitrator: str | None = setting(None)
+    neat: str | None = setting(None)
+    task: str | None = setting(None)
+
+
+def robot_folders() -> list[Path]:
+    """Where robot settings files are looked for.
+
+    ``config/robots``, then each folder of ``$EVORBC_ROBOT_PATH`` in order (empty entries
+    skipped).
+    """
+    folders = [config_dir() / "robots"]
+    for entry in os.environ.get(PATH_VARIABLE, "").split(os.pathsep):
+        if entry.strip():
+            folders.append(Path(entry).expanduser())
+    return folders
+
+
+def robot_files() -> list[Path]:
+    """Every ``*.yaml`` file in :func:`robot_folders`, by folder, then by name."""
+    files = []
+    for folder in robot_folders():
+        if folder.is_dir():
+            files += sorted(p for p in folder.glob("*.yaml") if p.is_file())
+    return files
+
+
+def _resolve(value: str, folder: Path) -> str:
+    """A file named in a robot settings file, as the registration keeps it.
+
+    Beside the file if there (made absolute), else as given, relative to ``config/``;
+    absolute paths as they are.
+    """
+    path = Path(value).expanduser()
+    if path.is_absolute():
+        return str(path)
+    beside = folder / path
+    return str(beside.resolve()) if beside.is_file() else value
+
+
+def read_robot_file(path: str | os.PathLike) -> Robot | None:
+    """The registration a robot settings file declares, or None if it has no ``kind``.
+
+    Raises:
+        ConfigError: one line naming the file and the key.
+
+    """
+    path = Path(path)
+    source = str(path)
+    values = load_yaml_mapping(path)
+    if "kind" not in values:
+        return None
+    keys = build_settings(RobotFileKeys, values, source)
+    geometry = keys.geometry if keys.geometry is not None else {}
+    if not isinstance(geometry, dict):
+        raise ConfigError(f"{source}: geometry must be a mapping of the {keys.kind} robot's keys")
+    files = keys.settings if keys.settings is not None else {}
+    if not isinstance(files, dict):
+        raise ConfigError(
+            f"{source}: settings must be a mapping of repertoire, arbitrator, neat, task"
+        )
+    files = build_settings(_SettingsKeys, files, f"{source}: settings")
+    folder = path.resolve().parent
+    builder = {"four_ws": _four_ws, "diff_drive": _diff_drive}[keys.kind]
+    robot = builder(keys, geometry, source)
+    given = {
+        f.name: _resolve(getattr(files, f.name), folder)
+        for f in dataclasses.fields(files)
+        if getattr(files, f.name) is not None
+    }
+    changes = {
+        "name": keys.name or path.stem,
+        "settings": dataclasses.replace(robot.settings, **given),
+        "source": source,
+    }
+    if keys.description:
+        changes["description"] = keys.description
+    if keys.sensors is not None:
+        changes["sensors"] = _resolve(keys.sensors, folder)
+    for key in ("episode_time", "equal_budget_generations"):
+        if getattr(keys, key) is not None:
+            changes[key] = getattr(keys, key)
+    if keys.maze is not None:
+        changes["maze"] = _resolve(keys.maze, folder)
+    robot = dataclasses.replace(robot, **changes)
+    _check_files(robot, source)
+    return robot
+
+
+def _check_files(robot: Robot, source: str) -> None:
+    """Every file the robot names exists, so a typo is reported against this file."""
+    named = {
+        f"settings.{f.name}": getattr(robot.settings, f.name)
+        for f in dataclasses.fields(SettingsFiles)
+    }
+    named["sensors"] = robot.sensors
+    for key, value in named.items():
+        file = Path(value) if Path(value).is_absolute() else config_dir() / value
+        if not file.is_file():
+            raise ConfigError(
+                f"{source}: {key}: no such file {value} (looked beside this file and in "
+                f"{config_dir()})"
+            )
+
+
+def _four_ws(keys: RobotFileKeys, geometry: dict, source: str) -> Robot:
+    """A 4WS robot: one of the paper's gene layouts on the file's body."""
+    from evorbc_ros.robots.builtin.four_ws import four_ws_robot
+    from evorbc_ros.robots.four_ws import ROBOT_TYPES, FourWSGeometry, paper_geometry
+
+    if keys.type not in ROBOT_TYPES:
+        raise ConfigError(
+            f"{source}: type must be one of {', '.join(ROBOT_TYPES)} (the paper's 4WS gene "
+            f"layouts), got {keys.type!r}"
+        )
+    body = FourWSGeometry.from_mapping(geometry, f"{source}: geometry", base=paper_geometry())
+    layout = ROBOT_TYPES[keys.type]
+    name = keys.name or Path(source).stem
+    return four_ws_robot(
+        dataclasses.replace(layout, name=name, geometry=body),
+        f"4WS robot ({keys.type} genes) of its own dimensions",
+    )
+
+
+def _diff_drive(keys: RobotFileKeys, geometry: dict, source: str) -> Robot:
+    """A differential-drive robot."""
+    from evorbc_ros.robots.builtin.diff_drive import diff_drive_robot
+    from evorbc_ros.robots.diff_drive import DiffDriveGeometry
+
+    if keys.type is not None:
+        raise ConfigError(f"{source}: type is for four_ws robots; remove it")
+    body = DiffDriveGeometry.from_mapping(geometry, f"{source}: geometry")
+    return diff_drive_robot(keys.name or Path(source).stem, body)
