@@ -158,8 +158,8 @@ def _markdown(study, settings: list[SettingResults], keys, claims, drawn, result
         "",
         f"* Settings: {len(settings)} ({', '.join(keys)} over the grid of "
         f"[config/studies/{Path(study.source).name}](../../config/studies/{Path(study.source).name})).",
-        f"* Runs finished: {proto['runs']}, {proto['min_seeds']}-{proto['max_seeds']} seeds "
-        f"per setting (the full protocol has {study.seeds}).",
+        f"* Runs finished: {proto['runs']}, {_span(proto['min_seeds'], proto['max_seeds'])} "
+        f"seeds per setting (the full protocol has {study.seeds}).",
         f"* NEAT generations per run: {gens} (Table I: the study file's).",
         "* Each run: its own repertoire (EvoRBC) and arbitrator, or a standard-NEAT "
         "controller, seeded by the run's seed; the figure is the run's highest training "
@@ -307,3 +307,9 @@ def default_out() -> Path:
     """``docs/study`` of the source tree (or the current folder when installed)."""
     root = Path(__file__).resolve().parents[2]
     return root / "docs" / "study" if (root / "docs").is_dir() else Path(os.getcwd())
+
+
+def _span(low: int, high: int) -> str:
+    """``"10"`` or ``"5-10"``: a count that may differ between settings."""
+    return str(low) if low == high else f"{low}-{high}"
+
