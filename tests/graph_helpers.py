@@ -114,3 +114,33 @@ def assert_same_choices(choices, result, k=0):
     assert len(choices) in (cycles, cycles + 1)
     np.testing.assert_array_equal(choices[:cycles], result.choice[k, :cycles])
     return cycles
+
+
+def switching_arbitrator(task, rep, robot, neat_path, tries=20, evolution=None):
+    """An EvoRBC arbitrator of random NEAT genomes whose replay from the maze's nominal start
+    switches among at least 3 primitives (the first of ``tries`` seeds that does).
+
+    Returns ``(arbitrator, outcome, result)``: the file and the offline episode's outcome
+    and recorded result.
+    """
+    from neat_helpers import neat_config, network_spec, random_genomes
+
+    from evorbc_ros.arbitrator import ArbitratorFile
+    from offline_evolution.maze_task.replay import replay
+
+    config = neat_config(6, 2, path=neat_path)
+    for seed in range(tries):
+        network = network_spec(random_genomes(config, 1, seed=seed)[0], config)
+        arb = ArbitratorFile(
+            kind="evorbc",
+            robot=robot,
+            network=network,
+            sensors=task.layout,
+            mapping="polar",
+            repertoire={"fingerprint": rep.fingerprint(), "robot": robot, "count": len(rep)},
+            evolution=evolution or {},
+        )
+        outcomes, result = replay(arb, task, task.nominal_starts(), rep)
+        if len(set(result.choice[0, : result.cycles[0]].tolist())) >= 3:
+            break
+    return arb, outcomes[0], result

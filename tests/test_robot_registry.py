@@ -10,8 +10,8 @@ from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.registry import Registry, RobotError, UnknownRobot
 
-BUILTIN = ("2ws-2", "2ws-3", "4ws-3", "4ws-5", "hexapod")
-KNOWN = "known robots: 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod"
+BUILTIN = ("2ws-2", "2ws-3", "4ws-3", "4ws-5", "hexapod", "a1")
+KNOWN = "known robots: 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod, a1"
 
 
 def test_the_builtin_robots_are_each_declared_once_and_completely():
@@ -34,7 +34,7 @@ def test_the_builtin_robots_are_each_declared_once_and_completely():
         if robot.shipped_arbitrator:
             assert default_arbitrator(name).is_file() and default_repertoire(name).is_file()
     equal = {n: registry.lookup(n).equal_budget_generations for n in BUILTIN}
-    assert equal == {"2ws-2": 25, "2ws-3": 25, "4ws-3": 25, "4ws-5": 25, "hexapod": 455}
+    assert equal == {"2ws-2": 25, "2ws-3": 25, "4ws-3": 25, "4ws-5": 25, "hexapod": 455, "a1": 341}
     assert [r.name for r in registry.robots() if r.shipped_arbitrator] == ["4ws-5", "hexapod"]
 
 
@@ -77,7 +77,7 @@ def test_an_unknown_robot_in_a_settings_file_is_named_with_its_key(tmp_path):
     with pytest.raises(ConfigError) as info:
         load_settings(path)
     assert str(info.value) == (
-        f"{path}: robot must be one of 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod; got 'tank'"
+        f"{path}: robot must be one of 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod, a1; got 'tank'"
     )
 
 
@@ -191,4 +191,4 @@ def test_looking_up_a_robot_onboard_loads_no_simulation_or_search_code():
 def test_the_names_are_live_choices():
     assert "hexapod" in registry.ROBOT_NAMES and "tank" not in registry.ROBOT_NAMES
     assert 5 not in registry.ROBOT_NAMES
-    assert list(registry.ROBOT_NAMES) == list(BUILTIN) and len(registry.ROBOT_NAMES) == 5
+    assert list(registry.ROBOT_NAMES) == list(BUILTIN) and len(registry.ROBOT_NAMES) == 6

@@ -117,17 +117,20 @@ class PrimitiveExecutorNode(Node):
                 "joint_trajectory_controller/joint_trajectory",
                 "hexapod joint targets (JointTrajectory, rad)",
             )
-            finite_parameter(
-                self,
-                "trajectory_rate",
-                SERVO_RATE,
-                "hexapod trajectory points per second (the simulation's physics rate)",
-                positive=True,
-            )
             try:
                 interface = spec.load("commands")
             except RobotError as e:
                 raise StartupError(str(e)) from None
+            # A joint-trajectory interface says its robot's own rate (a legged robot's
+            # physics rate); the wheel interfaces do not use it.
+            default_rate = getattr(interface, "default_rate", None)
+            finite_parameter(
+                self,
+                "trajectory_rate",
+                default_rate(spec) if default_rate else SERVO_RATE,
+                "legged robots' trajectory points per second (default: the robot's physics rate)",
+                positive=True,
+            )
         self.robot = robot
         self.parameter_names = list(spec.parameter_names)
         self.primitive_topic = primitive_topic

@@ -1,0 +1,75 @@
+"""Benchmark: A1 primitive evaluations per second and the cost of a Table I repertoire.
+
+Evaluates the same random A1 primitives (T = 2 s, stopped early past the discard tilt, as
+MAP-Elites runs them) on 1 and on 2 worker processes (one PyBullet client each), and
+prints evaluations per second, the CPU cost of one evaluation, and the projected wall time
+of a Table I-sized repertoire (25k + 1000 x 1000 evaluations) and of the reduced run of
+docs/a1.md. Random primitives fall more often than a repertoire's mutants do (41 % stay
+upright, docs/a1.md), and a fall ends an evaluation early, so the projection is a lower
+bound; the reduced run's own rate is printed beside it in docs/a1.md.
+
+    python bench/bench_a1.py [--n 400] [--workers 1,2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+
+import numpy as np
+
+from evorbc_ros.robots import registry
+from offline_evolution.repertoire.settings import load_settings
+from sim_bridge.legged.pool import available_cores
+from sim_bridge.legged.robot import simulated_robot
+
+
+def machine() -> str:
+    """CPU model and core count."""
+    names = []
+    if os.path.exists("/proc/cpuinfo"):
+        with open("/proc/cpuinfo") as f:
+            names = [line.split(":", 1)[1].strip() for line in f if line.startswith("model name")]
+    return f"{names[0] if names else platform.machine()}, {available_cores()} cores"
+
+
+def throughput(n: int, workers: int) -> float:
+    """Evaluations per second of ``n`` random primitives on ``workers`` processes."""
+    settings = load_settings(robot="a1")
+    robot = simulated_robot(registry.lookup("a1"), workers=workers)
+    try:
+        genes = np.random.default_rng(0).uniform(-1, 1, size=(n, robot.settings.gait.n_parameters))
+        robot.evaluate_primitives(genes[: 20 * workers], settings.eval_time)  # start workers
+        start = time.perf_counter()
+        out = robot.evaluate_primitives(genes, settings.eval_time)
+        wall = time.perf_counter() - start
+    finally:
+        robot.close()
+    rate = n / wall
+    upright = float(np.mean(out.max_tilt <= robot.settings.discard_tilt))
+    print(
+        f"{n} random primitives of {settings.eval_time:g} s on {workers} worker(s): "
+        f"{wall:.1f} s = {rate:.1f} evaluations/s ({1e3 / rate * workers:.1f} ms each per "
+        f"worker; {upright:.0%} upright); Table I ({settings.evaluations:,} evaluations) "
+        f"projected {settings.evaluations / rate / 3600:.2f} h  [load {os.getloadavg()[0]:.1f}]",
+        flush=True,
+    )
+    return rate
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--n", type=int, default=400, help="random primitives (400)")
+    parser.add_argument("--workers", default="1,2", help="worker counts to measure (1,2)")
+    args = parser.parse_args()
+    a1 = registry.lookup("a1")
+    print(f"machine: {machine()}; {a1.description}")
+    print(f"physics: {a1.model.physics_rate:g} Hz")
+    for workers in map(int, args.workers.split(",")):
+        throughput(args.n, workers)
+
+
+if __name__ == "__main__":
+    main()
