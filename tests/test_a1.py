@@ -64,7 +64,7 @@ def test_the_a1_settings_files_belong_together():
     assert rep.robot == "a1" and rep.metric == "circular+tilt" and rep.eval_time == 2.0
     run = load_run_settings(robot="a1")
     task = MazeTaskSettings.load(run.task_path())
-    assert task.mazes == ("a1",) and task.episode_time == a1.episode_time == 40.0
+    assert task.mazes == ("a1",) and task.episode_time == a1.episode_time == 30.0
     assert config_dir() / task.sensors == a1.sensors_file()
     config = load_neat_config(run.neat_path(), 6, 2)  # 5 laser groups and the goal bearing
     assert config.pop_size == 150

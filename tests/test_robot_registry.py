@@ -34,7 +34,7 @@ def test_the_builtin_robots_are_each_declared_once_and_completely():
         if robot.shipped_arbitrator:
             assert default_arbitrator(name).is_file() and default_repertoire(name).is_file()
     equal = {n: registry.lookup(n).equal_budget_generations for n in BUILTIN}
-    assert equal == {"2ws-2": 25, "2ws-3": 25, "4ws-3": 25, "4ws-5": 25, "hexapod": 455, "a1": 341}
+    assert equal == {"2ws-2": 25, "2ws-3": 25, "4ws-3": 25, "4ws-5": 25, "hexapod": 455, "a1": 455}
     assert [r.name for r in registry.robots() if r.shipped_arbitrator] == ["4ws-5", "hexapod"]
 
 

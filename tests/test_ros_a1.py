@@ -94,7 +94,7 @@ def test_evorbc_sim_runs_the_a1(tmp_path, controller, capsys):
     assert main([*argv, "--domain-id", "172"]) == 0
     got = json.loads(result.read_text())
     assert got["robot"] == "a1" and got["maze"] == "a1" and got["reached"]
-    assert got["episode_time"] == 40.0
+    assert got["episode_time"] == 30.0
 
 
 def test_evorbc_sim_refuses_an_a1_repertoire_of_another_design(tmp_path, controller, capsys):

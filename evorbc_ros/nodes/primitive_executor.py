@@ -13,6 +13,9 @@ following ros2_control's command conventions (reliable):
   (trajectory_msgs/JointTrajectory): ``joint_trajectory_controller/joint_trajectory``,
   the 18 joints' targets (rad) for the next ``stale_timeout`` s, one point per physics
   step (``trajectory_rate``, 50 Hz), see :mod:`evorbc_ros.hexapod_executor`.
+* legged robots from a settings file, such as the A1
+  (:mod:`evorbc_ros.nodes.legged_commands`): the same, for the robot's joints, at its own
+  physics rate (the A1: 12 joints, 100 Hz) unless ``trajectory_rate`` is set.
 
 The node declares the parameters of both (topics, ``wheel_radius``, ``trajectory_rate``),
 whichever robot it drives, so one parameter file serves every robot.
