@@ -1,7 +1,9 @@
-"""The robot-specific half of the simulation bridge: a 4WS robot or the hexapod.
+"""The robot-specific half of the simulation bridge: a 4WS robot, or a legged one.
 
-Each adapter owns its simulated world, subscribes its command topics, fills the joint
-states and laser scan, and steps the world with the commands of the cycle. The bridge node
+The legged adapters are :class:`HexapodBridge` and, for any legged robot from a settings
+file, :mod:`sim_bridge.legged.bridge`; both are :class:`TrajectoryBridge`. Each adapter
+owns its simulated world, subscribes its command topics, fills the joint states and laser
+scan, and steps the world with the commands of the cycle. The bridge node
 (:mod:`sim_bridge.bridge_node`) runs the loop, clock, odometry and result the same way for
 every robot, and finds a robot's adapter through its registration's ``bridge`` field
 (docs/your-robot.md gives the adapter's interface).
