@@ -144,3 +144,30 @@ def switching_arbitrator(task, rep, robot, neat_path, tries=20, evolution=None):
         if len(set(result.choice[0, : result.cycles[0]].tolist())) >= 3:
             break
     return arb, outcomes[0], result
+
+
+def assert_lockstep_reproduces(tmp_path, domain, robot, maze, controller, episode_time):
+    """Run the lockstep graph with ``controller`` (the fixture's arbitrator, repertoire,
+    offline outcome and result) and assert it reproduces the offline episode: the same
+    primitive at every cycle, at least 3 different ones, identical poses (bit for bit),
+    the same robot and fitness. Returns the graph's trajectory ``(cycles + 1, 3)``."""
+    import pytest
+
+    arb_path, rep_path, outcome, result = controller
+    run = GraphRun(
+        tmp_path,
+        domain,
+        maze,
+        episode_time=episode_time,
+        arbitrator=arb_path,
+        repertoire=rep_path,
+        robot=robot,
+    )
+    got = run.finish(timeout=120)
+    choices = run.recorded_choices()
+    cycles = assert_same_choices(choices, result)
+    assert len(set(choices.tolist())) >= 3  # the arbitrator switched primitives
+    trajectory = np.array(got["trajectory"])
+    np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
+    assert got["robot"] == robot and got["fitness"] == pytest.approx(outcome.fitness)
+    return trajectory

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 from a1_helpers import a1_settings, trot_repertoire
-from graph_helpers import GraphRun, assert_same_choices, switching_arbitrator
+from graph_helpers import assert_lockstep_reproduces, switching_arbitrator
 from trajectory_msgs.msg import JointTrajectory
 
 from evorbc_ros.nodes.common import vector_message
@@ -39,23 +39,7 @@ def controller(tmp_path_factory):
 
 
 def test_lockstep_graph_reproduces_the_offline_a1_episode(tmp_path, controller):
-    arb_path, rep_path, outcome, result = controller
-    run = GraphRun(
-        tmp_path,
-        171,
-        "a1",
-        episode_time=EPISODE,
-        arbitrator=arb_path,
-        repertoire=rep_path,
-        robot="a1",
-    )
-    got = run.finish(timeout=120)
-    choices = run.recorded_choices()
-    cycles = assert_same_choices(choices, result)
-    assert len(set(choices.tolist())) >= 3  # the arbitrator switched primitives
-    trajectory = np.array(got["trajectory"])
-    np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
-    assert got["robot"] == "a1" and got["fitness"] == pytest.approx(outcome.fitness)
+    trajectory = assert_lockstep_reproduces(tmp_path, 171, "a1", "a1", controller, EPISODE)
     assert np.hypot(*(trajectory[-1, :2] - trajectory[0, :2])) > 0.1  # it walked
 
 

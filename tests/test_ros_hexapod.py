@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 from builtin_interfaces.msg import Duration
-from graph_helpers import GraphRun, assert_same_choices, switching_arbitrator
+from graph_helpers import assert_lockstep_reproduces, switching_arbitrator
 from hexapod_helpers import tripod_repertoire
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
@@ -81,23 +81,9 @@ def controller(tmp_path_factory):
 
 
 def test_lockstep_graph_reproduces_the_offline_episode(tmp_path, controller):
-    arb_path, rep_path, outcome, result = controller
-    run = GraphRun(
-        tmp_path,
-        170,
-        "hexapod",
-        episode_time=EPISODE,
-        arbitrator=arb_path,
-        repertoire=rep_path,
-        robot="hexapod",
+    trajectory = assert_lockstep_reproduces(
+        tmp_path, 170, "hexapod", "hexapod", controller, EPISODE
     )
-    got = run.finish(timeout=120)
-    choices = run.recorded_choices()
-    cycles = assert_same_choices(choices, result)
-    assert len(set(choices.tolist())) >= 3  # the arbitrator switched primitives
-    trajectory = np.array(got["trajectory"])
-    np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
-    assert got["robot"] == "hexapod" and got["fitness"] == pytest.approx(outcome.fitness)
     assert np.hypot(*(trajectory[-1, :2] - trajectory[0, :2])) > 0.2  # it walked
 
 
