@@ -1,17 +1,24 @@
 """Which A1 gait design walks without falling? Joint ranges, couplings, frequency, servos.
 
-Each variant changes ``config/robots/a1.yaml`` (the current design) and is measured on
-the same random primitives (T = 2 s from rest, the repertoire's test):
+Each variant is a change to the *first design* (:func:`first_design`: hip abduction
++-12 deg, swing +-25 deg, knee -103 +-29 deg, 2 Hz, servo gain 20 /s) or, for "chosen",
+the design ``config/robots/a1.yaml`` holds now, and is measured on the same random
+primitives (T = 2 s from rest, the repertoire's test). Runs made while the first design was
+the settings file's printed it as "current"; docs/a1.md records both.
 
 * upright: the share whose body never tilts past the discard tilt (45 deg);
 * the reach (distance from the start after T) of the upright ones: median, 90th
   percentile and largest, and how many 8 cm cells of displacement they fill, left and
   right of the start's axis;
-* switching: the faster half of the upright primitives, chained at random every control
-  cycle (0.1 s) or every second for 10 s, as an arbitrator may chain them; a fall is a
-  tilt past 90 deg.
+* switching: the faster half of the upright primitives (or, with ``--pool-tilt DEG``,
+  the upright ones that never tilted past DEG in their 2 s), chained at random every
+  control cycle (0.1 s) or every second for 10 s, as an arbitrator may chain them; a fall
+  is a tilt past 90 deg;
+* holding: the same primitives, each run alone for 10 s: does a gait that stayed upright
+  for its 2 s test stay upright for longer, without any switch?
 
     python bench/bench_a1_design.py [--primitives 100] [--episodes 20] [--only NAME]
+        [--pool-tilt DEG]
 """
 
 from __future__ import annotations
@@ -31,6 +38,31 @@ from sim_bridge.legged.settings import robot_settings_from_mapping
 SETTINGS = "config/robots/a1.yaml"
 LEGS = ("FL", "FR", "RL", "RR")
 CELL = 0.08  # m, the cells counted for the spread of displacements
+
+
+def first_design(data: dict) -> None:
+    """The first A1 design, whatever ``config/robots/a1.yaml`` holds now.
+
+    Per leg, oscillators hip (abduction, +-12 deg, the right leg's the mirror image with
+    the opposite sign), swing (+-25 deg) and knee (-132 to -74 deg), each hip joint driven
+    by its hip oscillator; 2 Hz, servo gain 20 /s.
+    """
+    mirror = {"FL": "FR", "FR": "FL", "RL": "RR", "RR": "RL"}
+    o = {}
+    for leg in LEGS:
+        o[f"{leg}_hip"] = {
+            "range_deg": [-12, 12],
+            "mirror": f"{mirror[leg]}_hip",
+            "mirror_sign": -1,
+        }
+        o[f"{leg}_swing"] = {"range_deg": [-25, 25], "mirror": f"{mirror[leg]}_swing"}
+        o[f"{leg}_knee"] = {"range_deg": [-132, -74], "mirror": f"{mirror[leg]}_knee"}
+        data["joints"][f"{leg}_hip_joint"] = {f"{leg}_hip": 1}
+        data["joints"][f"{leg}_upper_joint"] = {f"{leg}_swing": 1, f"{leg}_knee": -0.5}
+        data["joints"][f"{leg}_lower_joint"] = {f"{leg}_knee": 1}
+    data["oscillators"] = o
+    data["gait"]["frequency_hz"] = 2.0
+    data["servo"]["gain"] = 20.0
 
 
 def oscillators(data: dict, name: str, **entry) -> None:
@@ -88,20 +120,61 @@ def _set(section, key, value):
 
 
 VARIANTS = {
-    "current": [],
-    "1 Hz": [_set("gait", "frequency_hz", 1.0)],
-    "1.5 Hz": [_set("gait", "frequency_hz", 1.5)],
-    "direct thigh/calf +-23/29 deg": [lambda d: direct(d, 23.0, 29.0)],
-    "swing 15, knee 20": [_swing(15.0), _knee(20.0)],
-    "swing 35, knee 29": [_swing(35.0)],
-    "knee 15": [_knee(15.0)],
-    "hip 6": [_hip(6.0)],
-    "hip 20": [_hip(20.0)],
-    "hips fixed": [fixed_hips],
-    "gain 40": [_set("servo", "gain", 40.0)],
-    "gain 10": [_set("servo", "gain", 10.0)],
-    "torque 20": [_set("servo", "max_torque", 20.0)],
-    "velocity 10": [_set("servo", "max_velocity", 10.0)],
+    "first design": [first_design],
+    "1 Hz": [first_design, _set("gait", "frequency_hz", 1.0)],
+    "1.5 Hz": [first_design, _set("gait", "frequency_hz", 1.5)],
+    "direct thigh/calf +-23/29 deg": [first_design, lambda d: direct(d, 23.0, 29.0)],
+    "swing 15, knee 20": [first_design, _swing(15.0), _knee(20.0)],
+    "swing 35, knee 29": [first_design, _swing(35.0)],
+    "knee 15": [first_design, _knee(15.0)],
+    "hip 6": [first_design, _hip(6.0)],
+    "hip 20": [first_design, _hip(20.0)],
+    "hips fixed": [first_design, fixed_hips],
+    "gain 40": [first_design, _set("servo", "gain", 40.0)],
+    "gain 10": [first_design, _set("servo", "gain", 10.0)],
+    "torque 20": [first_design, _set("servo", "max_torque", 20.0)],
+    "velocity 10": [first_design, _set("servo", "max_velocity", 10.0)],
+    "knee 15, gain 10": [first_design, _knee(15.0), _set("servo", "gain", 10.0)],
+    "swing 15, knee 15, gain 10": [
+        first_design,
+        _swing(15.0),
+        _knee(15.0),
+        _set("servo", "gain", 10.0),
+    ],
+    "knee 15, gain 10, hips fixed": [
+        first_design,
+        _knee(15.0),
+        _set("servo", "gain", 10.0),
+        fixed_hips,
+    ],
+    "swing 20, knee 15, gain 10": [
+        first_design,
+        _swing(20.0),
+        _knee(15.0),
+        _set("servo", "gain", 10.0),
+    ],
+    "swing 20, knee 15, gain 10, hips fixed": [
+        first_design,
+        _swing(20.0),
+        _knee(15.0),
+        _set("servo", "gain", 10.0),
+        fixed_hips,
+    ],
+    "knee 15, gain 10, hips fixed, 2.5 Hz": [
+        first_design,
+        _knee(15.0),
+        _set("servo", "gain", 10.0),
+        fixed_hips,
+        _set("gait", "frequency_hz", 2.5),
+    ],
+    "swing 15, knee 15, gain 10, 2.5 Hz": [
+        first_design,
+        _swing(15.0),
+        _knee(15.0),
+        _set("servo", "gain", 10.0),
+        _set("gait", "frequency_hz", 2.5),
+    ],
+    "chosen (config/robots/a1.yaml)": [],
 }
 
 
@@ -134,8 +207,11 @@ def study(name: str, changes, args) -> dict:
         cells = {tuple(c) for c in np.floor(out[upright][:, [X, Y]] / CELL + 0.5).astype(int)}
         left = sum(1 for c in cells if c[1] > 0)
         right = sum(1 for c in cells if c[1] < 0)
-        fast = upright & (reach >= np.median(reach[upright]))
-        table = sim.gait_table(genes[fast])
+        if args.pool_tilt is None:
+            pool = upright & (reach >= np.median(reach[upright]))
+        else:
+            pool = out[:, TILT] <= np.radians(args.pool_tilt)
+        table = sim.gait_table(genes[pool])
         n, fallen = len(table), settings.fallen_tilt
         every = sum(
             episode(sim, table, rng.integers(n, size=100), 1, fallen) for _ in range(args.episodes)
@@ -143,6 +219,8 @@ def study(name: str, changes, args) -> dict:
         second = sum(
             episode(sim, table, rng.integers(n, size=10), 10, fallen) for _ in range(args.episodes)
         )
+        held = [k % n for k in range(args.episodes)]
+        alone = sum(episode(sim, table, np.array([k]), 100, fallen) for k in held)
     r = {
         "upright": float(upright.mean()),
         "reach_median": float(np.median(reach[upright])),
@@ -153,12 +231,15 @@ def study(name: str, changes, args) -> dict:
         "right": right,
         "fell_switching_0.1s": every,
         "fell_switching_1s": second,
+        "pool": n,
+        "fell_holding_10s": alone,
     }
     print(
         f"{name:<32} upright {r['upright']:4.0%}  reach median {r['reach_median']:.2f} "
         f"p90 {r['reach_p90']:.2f} max {r['reach_max']:.2f} m  cells {len(cells):>3} "
         f"(L {left} R {right})  fell switching every 0.1 s {every:>2}/{args.episodes}, "
-        f"every 1 s {second:>2}/{args.episodes}  [{time.perf_counter() - start:.0f} s, "
+        f"every 1 s {second:>2}/{args.episodes}, holding one {alone:>2}/{args.episodes} "
+        f"(pool {n})  [{time.perf_counter() - start:.0f} s, "
         f"load {os.getloadavg()[0]:.1f}]",
         flush=True,
     )
@@ -171,6 +252,9 @@ def main() -> None:
     parser.add_argument("--episodes", type=int, default=20)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--only", help="run only the variants whose name contains this")
+    parser.add_argument(
+        "--pool-tilt", type=float, help="switch among primitives that tilted at most DEG"
+    )
     args = parser.parse_args()
     for name, changes in VARIANTS.items():
         if args.only is None or args.only in name:

@@ -32,7 +32,7 @@ from sim_bridge.legged.settings import LeggedRobotSettings, load_robot_settings
 T = 2.0
 NO_EARLY_STOP = math.radians(180.0)  # run every primitive the full T to compare endpoints
 REFERENCE = (1000.0, 50)
-CANDIDATES = "50/50,100/30,100/50,125/50,200/30,200/50,250/50,500/50"
+CANDIDATES = "50/50,100/30,100/50,150/50,200/30,200/50,250/50,500/50"
 
 
 def with_physics(settings: LeggedRobotSettings, rate: float, iterations: int):

@@ -1,9 +1,10 @@
-"""The robot-specific half of the simulation bridge: a 4WS robot or the hexapod.
+"""The robot-specific half of the simulation bridge: a 4WS robot, or a legged one.
 
-A differential-drive robot's is :mod:`sim_bridge.diff_drive_bridge`.
-
-Each adapter owns its simulated world, subscribes its command topics, fills the joint
-states and laser scan, and steps the world with the commands of the cycle. The bridge node
+A differential-drive robot's is :mod:`sim_bridge.diff_drive_bridge`. The legged adapters
+are :class:`HexapodBridge` and, for any legged robot from a settings file,
+:mod:`sim_bridge.legged.bridge`; both are :class:`TrajectoryBridge`. Each adapter
+owns its simulated world, subscribes its command topics, fills the joint states and laser
+scan, and steps the world with the commands of the cycle. The bridge node
 (:mod:`sim_bridge.bridge_node`) runs the loop, clock, odometry and result the same way for
 every robot, and finds a robot's adapter through its registration's ``bridge`` field
 (docs/your-robot.md gives the adapter's interface).
@@ -27,7 +28,7 @@ from evorbc_ros.nodes.common import (
     robot_named,
 )
 from evorbc_ros.robots.four_ws import WHEEL_NAMES
-from evorbc_ros.robots.hexapod import HEXAPOD, JOINT_NAMES
+from evorbc_ros.robots.hexapod import JOINT_NAMES
 from evorbc_ros.robots.registry import RobotError
 from sim_bridge.hexapod.maze_world import HexapodMazeWorld
 from sim_bridge.world import LaserConfig, SimWorld
@@ -157,20 +158,30 @@ class FourWSBridge(KinematicBridge):
         msg.velocity = [0.0] * 4 + [self.world.speed / self.wheel_radius] * 4
 
 
-class HexapodBridge:
-    """The hexapod: a JointTrajectory of targets per control period, PyBullet dynamics."""
+class TrajectoryBridge:
+    """A legged robot: a JointTrajectory of targets per control period, PyBullet dynamics.
+
+    Subclasses give :meth:`make_world` (a :class:`~sim_bridge.legged.maze_world.LeggedMazeWorld`)
+    and :attr:`joint_names` (the world's joints, in its command order).
+    """
 
     command_keys = ("trajectory",)
+    joint_names: tuple[str, ...] = ()
+
+    def make_world(self, robot: str, maze, pose, episode_time: float, gui: bool):
+        """The simulated robot in ``maze`` at ``pose`` (None: the maze's nominal start)."""
+        raise NotImplementedError
 
     def __init__(self, node, robot: str, maze, pose, episode_time: float, gui: bool) -> None:
         self.node = node
+        self.name = robot
         self.topic = declare(
             node,
             "trajectory_topic",
             "joint_trajectory_controller/joint_trajectory",
             "joint trajectory command topic",
         )
-        self.world = HexapodMazeWorld(maze, pose, episode_time, gui)
+        self.world = self.make_world(robot, maze, pose, episode_time, gui)
         # The latest trajectory resampled at the physics steps, and the next step to run:
         # a trajectory longer than a period keeps the legs walking until the next arrives.
         self.trajectory: np.ndarray | None = None
@@ -179,10 +190,8 @@ class HexapodBridge:
         self.scan_geometry = ScanGeometry(
             s.angle_min, s.angle_max, s.angle_increment, s.range_min, s.range_max
         )
-        self.index = {name: k for k, name in enumerate(JOINT_NAMES)}
+        self.index = {name: k for k, name in enumerate(self.joint_names)}
         self.dt = self.world.physics.dt
-
-    name = HEXAPOD
 
     def subscribe(self, on_command) -> list:
         """The trajectory subscription; ``on_command("trajectory")`` once one is stored."""
@@ -205,18 +214,19 @@ class HexapodBridge:
         on_command("trajectory")
 
     def _targets(self, msg: JointTrajectory) -> tuple[str, np.ndarray | None]:
-        """``(problem, (steps, 18) targets)``: points resampled at the physics steps."""
-        names = list(msg.joint_names)
-        if sorted(names) != sorted(JOINT_NAMES):
-            return f"expected the 18 joints {', '.join(JOINT_NAMES)}, got {names}", None
+        """``(problem, (steps, joints) targets)``: points resampled at the physics steps."""
+        names, joints = list(msg.joint_names), self.joint_names
+        n = len(joints)
+        if sorted(names) != sorted(joints):
+            return f"expected the {n} joints {', '.join(joints)}, got {names}", None
         if not msg.points:
-            return "", np.empty((0, 18))  # "stop and hold where you are"
-        order = [names.index(n) for n in JOINT_NAMES]
+            return "", np.empty((0, n))  # "stop and hold where you are"
+        order = [names.index(j) for j in joints]
         times, rows = [], []
         for point in msg.points:
             q = np.asarray(point.positions, dtype=np.float64)
-            if q.shape != (18,) or not np.all(np.isfinite(q)):
-                return "every point needs 18 finite positions", None
+            if q.shape != (n,) or not np.all(np.isfinite(q)):
+                return f"every point needs {n} finite positions", None
             rows.append(q[order])
             times.append(point.time_from_start.sec + 1e-9 * point.time_from_start.nanosec)
         times = np.asarray(times)
@@ -258,12 +268,22 @@ class HexapodBridge:
         return tuple(pos), tuple(orn)
 
     def joint_state(self, msg: JointState) -> None:
-        """Fill the 18 joints' names, angles (rad), velocities (rad/s) and torques (N m)."""
+        """Fill the joints' names, angles (rad), velocities (rad/s) and torques (N m)."""
         q, v, tau = self.world.sim.joint_states()
-        msg.name = list(JOINT_NAMES)
+        msg.name = list(self.joint_names)
         msg.position = q.tolist()
         msg.velocity = v.tolist()
         msg.effort = tau.tolist()
+
+
+class HexapodBridge(TrajectoryBridge):
+    """The hexapod: its 18 joints, the maze world of :mod:`sim_bridge.hexapod.maze_world`."""
+
+    joint_names = JOINT_NAMES
+
+    def make_world(self, robot: str, maze, pose, episode_time: float, gui: bool):
+        """The hexapod in ``maze``."""
+        return HexapodMazeWorld(maze, pose, episode_time, gui)
 
 
 def bridge_robot_class(robot: str) -> type:

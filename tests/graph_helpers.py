@@ -114,3 +114,60 @@ def assert_same_choices(choices, result, k=0):
     assert len(choices) in (cycles, cycles + 1)
     np.testing.assert_array_equal(choices[:cycles], result.choice[k, :cycles])
     return cycles
+
+
+def switching_arbitrator(task, rep, robot, neat_path, tries=20, evolution=None):
+    """An EvoRBC arbitrator of random NEAT genomes whose replay from the maze's nominal start
+    switches among at least 3 primitives (the first of ``tries`` seeds that does).
+
+    Returns ``(arbitrator, outcome, result)``: the file and the offline episode's outcome
+    and recorded result.
+    """
+    from neat_helpers import neat_config, network_spec, random_genomes
+
+    from evorbc_ros.arbitrator import ArbitratorFile
+    from offline_evolution.maze_task.replay import replay
+
+    config = neat_config(6, 2, path=neat_path)
+    for seed in range(tries):
+        network = network_spec(random_genomes(config, 1, seed=seed)[0], config)
+        arb = ArbitratorFile(
+            kind="evorbc",
+            robot=robot,
+            network=network,
+            sensors=task.layout,
+            mapping="polar",
+            repertoire={"fingerprint": rep.fingerprint(), "robot": robot, "count": len(rep)},
+            evolution=evolution or {},
+        )
+        outcomes, result = replay(arb, task, task.nominal_starts(), rep)
+        if len(set(result.choice[0, : result.cycles[0]].tolist())) >= 3:
+            break
+    return arb, outcomes[0], result
+
+
+def assert_lockstep_reproduces(tmp_path, domain, robot, maze, controller, episode_time):
+    """Run the lockstep graph with ``controller`` (the fixture's arbitrator, repertoire,
+    offline outcome and result) and assert it reproduces the offline episode: the same
+    primitive at every cycle, at least 3 different ones, identical poses (bit for bit),
+    the same robot and fitness. Returns the graph's trajectory ``(cycles + 1, 3)``."""
+    import pytest
+
+    arb_path, rep_path, outcome, result = controller
+    run = GraphRun(
+        tmp_path,
+        domain,
+        maze,
+        episode_time=episode_time,
+        arbitrator=arb_path,
+        repertoire=rep_path,
+        robot=robot,
+    )
+    got = run.finish(timeout=120)
+    choices = run.recorded_choices()
+    cycles = assert_same_choices(choices, result)
+    assert len(set(choices.tolist())) >= 3  # the arbitrator switched primitives
+    trajectory = np.array(got["trajectory"])
+    np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
+    assert got["robot"] == robot and got["fitness"] == pytest.approx(outcome.fitness)
+    return trajectory

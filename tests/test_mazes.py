@@ -52,8 +52,8 @@ def nominal_path(name: str) -> float:
     return field.distance_from(*maze.start_pose[:2])
 
 
-def test_the_five_4ws_mazes_and_the_hexapod_maze_are_shipped():
-    assert maze_names() == sorted([*NAMES, "hexapod"])
+def test_the_five_4ws_mazes_the_hexapod_maze_and_the_a1_maze_are_shipped():
+    assert maze_names() == sorted([*NAMES, "hexapod", "a1"])
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -138,6 +138,6 @@ def test_a_broken_plugin_is_one_line_and_every_command_still_works(tmp_path):
     lines = out.stderr.splitlines()
     assert len(lines) == 2 and lines[0].startswith("evorbc: warning: robot plugin crab (")
     assert (
-        "invalid choice: 'crab' (choose from '2ws-2', '2ws-3', '4ws-3', '4ws-5', 'hexapod', "
+        "invalid choice: 'crab' (choose from '2ws-2', '2ws-3', '4ws-3', '4ws-5', 'hexapod', 'a1', "
         "'turtlebot3-burger')" in lines[1]
     )

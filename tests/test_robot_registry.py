@@ -10,10 +10,10 @@ from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.registry import Registry, RobotError, UnknownRobot
 
-BUILTIN = ("2ws-2", "2ws-3", "4ws-3", "4ws-5", "hexapod")
+BUILTIN = ("2ws-2", "2ws-3", "4ws-3", "4ws-5", "hexapod", "a1")
 #: Robots declared in config/robots/ settings files (after the built-in ones).
 FROM_FILES = ("turtlebot3-burger",)
-KNOWN = "known robots: 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod, turtlebot3-burger"
+KNOWN = "known robots: 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod, a1, turtlebot3-burger"
 
 
 def test_the_builtin_robots_are_each_declared_once_and_completely():
@@ -42,6 +42,7 @@ def test_the_builtin_robots_are_each_declared_once_and_completely():
         "4ws-3": 25,
         "4ws-5": 25,
         "hexapod": 455,
+        "a1": 455,
         "turtlebot3-burger": 25,
     }
     assert [r.name for r in registry.robots() if r.shipped_arbitrator] == ["4ws-5", "hexapod"]
@@ -86,7 +87,7 @@ def test_an_unknown_robot_in_a_settings_file_is_named_with_its_key(tmp_path):
     with pytest.raises(ConfigError) as info:
         load_settings(path)
     assert str(info.value) == (
-        f"{path}: robot must be one of 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod, turtlebot3-burger; "
+        f"{path}: robot must be one of 2ws-2, 2ws-3, 4ws-3, 4ws-5, hexapod, a1, turtlebot3-burger; "
         "got 'tank'"
     )
 

@@ -6,9 +6,8 @@ import math
 import numpy as np
 import pytest
 from builtin_interfaces.msg import Duration
-from graph_helpers import GraphRun, assert_same_choices
+from graph_helpers import assert_lockstep_reproduces, switching_arbitrator
 from hexapod_helpers import tripod_repertoire
-from neat_helpers import neat_config, network_spec, random_genomes
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from evorbc_ros.arbitrator import ArbitratorFile
@@ -17,7 +16,6 @@ from evorbc_ros.nodes.common import vector_message
 from evorbc_ros.nodes.primitive_executor import PrimitiveExecutorNode
 from evorbc_ros.robots.hexapod import JOINT_NAMES, SERVO_RATE, GaitTable
 from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
-from offline_evolution.maze_task.replay import replay
 from offline_evolution.maze_task.task import MazeTaskSettings
 from sim_bridge.hexapod.physics import HexapodSim
 
@@ -73,46 +71,19 @@ def controller(tmp_path_factory):
     task = HexapodMazeTask(
         MazeTaskSettings(("hexapod",), EPISODE, 1, "sensors/hexapod.yaml"), workers=1
     )
-    config = neat_config(6, 2, path="config/neat/hexapod.ini")
     try:
-        for seed in range(20):
-            network = network_spec(random_genomes(config, 1, seed=seed)[0], config)
-            arb = ArbitratorFile(
-                kind="evorbc",
-                robot="hexapod",
-                network=network,
-                sensors=task.layout,
-                mapping="polar",
-                repertoire={"fingerprint": rep.fingerprint(), "robot": "hexapod", "count": 6},
-            )
-            outcomes, result = replay(arb, task, task.nominal_starts(), rep)
-            if len(set(result.choice[0, : result.cycles[0]].tolist())) >= 3:
-                break
+        arb, outcome, result = switching_arbitrator(task, rep, "hexapod", "config/neat/hexapod.ini")
     finally:
         task.close()
     arb_path = tmp / "hexapod.arbitrator.json"
     arb.save(arb_path)
-    return arb_path, rep_path, outcomes[0], result
+    return arb_path, rep_path, outcome, result
 
 
 def test_lockstep_graph_reproduces_the_offline_episode(tmp_path, controller):
-    arb_path, rep_path, outcome, result = controller
-    run = GraphRun(
-        tmp_path,
-        170,
-        "hexapod",
-        episode_time=EPISODE,
-        arbitrator=arb_path,
-        repertoire=rep_path,
-        robot="hexapod",
+    trajectory = assert_lockstep_reproduces(
+        tmp_path, 170, "hexapod", "hexapod", controller, EPISODE
     )
-    got = run.finish(timeout=120)
-    choices = run.recorded_choices()
-    cycles = assert_same_choices(choices, result)
-    assert len(set(choices.tolist())) >= 3  # the arbitrator switched primitives
-    trajectory = np.array(got["trajectory"])
-    np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
-    assert got["robot"] == "hexapod" and got["fitness"] == pytest.approx(outcome.fitness)
     assert np.hypot(*(trajectory[-1, :2] - trajectory[0, :2])) > 0.2  # it walked
 
 

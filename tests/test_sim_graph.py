@@ -258,7 +258,7 @@ def test_a_mistyped_robot_is_one_line(capsys):
     assert info.value.code == 2
     assert err == [
         "evorbc-sim: error: argument --robot: invalid choice: '4ws5' (choose from '2ws-2', "
-        "'2ws-3', '4ws-3', '4ws-5', 'hexapod', 'turtlebot3-burger') (see evorbc-sim --help)"
+        "'2ws-3', '4ws-3', '4ws-5', 'hexapod', 'a1', 'turtlebot3-burger') (see evorbc-sim --help)"
     ]
 
 

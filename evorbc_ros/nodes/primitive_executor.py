@@ -13,6 +13,9 @@ following ros2_control's command conventions (reliable):
   (trajectory_msgs/JointTrajectory): ``joint_trajectory_controller/joint_trajectory``,
   the 18 joints' targets (rad) for the next ``stale_timeout`` s, one point per physics
   step (``trajectory_rate``, 50 Hz), see :mod:`evorbc_ros.hexapod_executor`.
+* legged robots from a settings file, such as the A1
+  (:mod:`evorbc_ros.nodes.legged_commands`): the same, for the robot's joints, at its own
+  physics rate (the A1: 12 joints, 100 Hz) unless ``trajectory_rate`` is set.
 
 The node declares the parameters of both (topics, ``wheel_radius``, ``trajectory_rate``),
 whichever robot it drives, so one parameter file serves every robot.
@@ -117,17 +120,20 @@ class PrimitiveExecutorNode(Node):
                 "joint_trajectory_controller/joint_trajectory",
                 "hexapod joint targets (JointTrajectory, rad)",
             )
-            finite_parameter(
-                self,
-                "trajectory_rate",
-                SERVO_RATE,
-                "hexapod trajectory points per second (the simulation's physics rate)",
-                positive=True,
-            )
             try:
                 interface = spec.load("commands")
             except RobotError as e:
                 raise StartupError(str(e)) from None
+            # A joint-trajectory interface says its robot's own rate (a legged robot's
+            # physics rate); the wheel interfaces do not use it.
+            default_rate = getattr(interface, "default_rate", None)
+            finite_parameter(
+                self,
+                "trajectory_rate",
+                default_rate(spec) if default_rate else SERVO_RATE,
+                "legged robots' trajectory points per second (default: the robot's physics rate)",
+                positive=True,
+            )
         self.robot = robot
         self.parameter_names = list(spec.parameter_names)
         self.primitive_topic = primitive_topic

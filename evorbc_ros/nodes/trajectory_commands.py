@@ -11,9 +11,10 @@ from __future__ import annotations
 from builtin_interfaces.msg import Duration
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from evorbc_ros.hexapod_executor import HexapodExecutor, JointTargets
+from evorbc_ros.hexapod_executor import HexapodExecutor
+from evorbc_ros.legged_executor import JointTargets, LeggedExecutor
 from evorbc_ros.nodes.common import RELIABLE
-from evorbc_ros.robots.hexapod import JOINT_NAMES
+from evorbc_ros.robots.hexapod import JOINT_NAMES, SERVO_RATE
 
 
 class JointTrajectoryCommands:
@@ -31,10 +32,21 @@ class JointTrajectoryCommands:
 
     def __init__(self, node, robot, inputs: list[str], stale_timeout: float) -> None:
         rate = float(node.get_parameter("trajectory_rate").value)
-        self.logic = HexapodExecutor(inputs, stale_timeout, rate)
+        self.logic = self.executor(robot, inputs, stale_timeout, rate)
+        self.joint_names = list(self.logic.gait.joint_names)
         self.pub = node.create_publisher(
             JointTrajectory, node.get_parameter("trajectory_topic").value, RELIABLE
         )
+
+    @staticmethod
+    def default_rate(robot) -> float:
+        """Trajectory points per second when ``trajectory_rate`` is not set: 50 Hz."""
+        return SERVO_RATE
+
+    @staticmethod
+    def executor(robot, inputs: list[str], stale_timeout: float, rate: float) -> LeggedExecutor:
+        """The pure executor logic for ``robot`` (the hexapod's)."""
+        return HexapodExecutor(inputs, stale_timeout, rate)
 
     def publish(self, command: JointTargets, halt: bool = False) -> None:
         """Send one command; none before the first target, which there is nothing to hold.
@@ -46,15 +58,18 @@ class JointTrajectoryCommands:
 
         """
         if len(command.positions):
-            self.pub.publish(trajectory_message(command))
+            self.pub.publish(trajectory_message(command, self.joint_names))
         elif halt:
-            self.pub.publish(JointTrajectory(joint_names=list(JOINT_NAMES)))
+            self.pub.publish(JointTrajectory(joint_names=self.joint_names))
 
 
-def trajectory_message(command: JointTargets) -> JointTrajectory:
-    """A JointTrajectory with point ``k`` at ``k * dt`` s (header stamp 0: start on receipt)."""
+def trajectory_message(command: JointTargets, joint_names=JOINT_NAMES) -> JointTrajectory:
+    """A JointTrajectory with point ``k`` at ``k * dt`` s (header stamp 0: start on receipt).
+
+    ``joint_names``: the joints of ``command.positions``' columns (default: the hexapod's).
+    """
     msg = JointTrajectory()
-    msg.joint_names = list(JOINT_NAMES)
+    msg.joint_names = list(joint_names)
     points = []
     for k, row in enumerate(command.positions):
         ns = round(k * command.dt * 1e9)

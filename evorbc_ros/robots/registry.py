@@ -11,8 +11,8 @@ registry by id).
 
 Where robots come from:
 
-* **Built in**: the modules in :data:`BUILTIN_MODULES` (the four 4WS types and the
-  hexapod), each with a module-level ``ROBOTS`` tuple, imported on the first look-up.
+* **Built in**: the modules in :data:`BUILTIN_MODULES` (the four 4WS types, the
+  hexapod and the A1), each with a module-level ``ROBOTS`` tuple, imported on the first look-up.
 * **Settings files**: YAML files with a ``kind`` key in ``config/robots/`` and in the
   folders of ``$EVORBC_ROBOT_PATH`` (:mod:`evorbc_ros.robots.settings_robots`): a robot
   declared without Python (a differential-drive robot, a 4WS robot of other dimensions).
@@ -50,7 +50,11 @@ from evorbc_ros.robots.primitive import ParameterSpec
 #: The entry-point group third-party packages add robots through.
 PLUGIN_GROUP = "evorbc.robots"
 #: Modules holding the built-in registrations (a ``ROBOTS`` tuple each), in listing order.
-BUILTIN_MODULES = ("evorbc_ros.robots.builtin.four_ws", "evorbc_ros.robots.builtin.hexapod")
+BUILTIN_MODULES = (
+    "evorbc_ros.robots.builtin.four_ws",
+    "evorbc_ros.robots.builtin.hexapod",
+    "evorbc_ros.robots.builtin.a1",
+)
 #: The robot every command and node uses when none is named.
 DEFAULT_ROBOT = "4ws-5"
 

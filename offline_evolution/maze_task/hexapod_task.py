@@ -85,14 +85,21 @@ class HexapodMazeTask(MazeTaskBase, SpawnedWorkers):
         """The robot's locomotion parameters (a standard controller's outputs, 37)."""
         return parameter_specs()
 
+    #: The controller, episode runner and worker functions of this task's episodes.
+    controller_type = HexapodController
+    runner_type = EpisodeRunner
+    worker_init = staticmethod(_init_worker)
+    worker_episode = staticmethod(_episode)
+
     def controller(
         self, kind: str, repertoire: Repertoire | None = None, mapping: str | None = None
     ) -> HexapodController:
         """An EvoRBC controller (repertoire and mapping) or a standard one."""
+        make = self.controller_type
         if kind == "evorbc":
             key = f"evorbc:{mapping}:{repertoire.fingerprint()}"
-            return HexapodController("evorbc", mapping, repertoire.genes, repertoire.behaviour, key)
-        return HexapodController("standard", key="standard")
+            return make("evorbc", mapping, repertoire.genes, repertoire.behaviour, key)
+        return make("standard", key="standard")
 
     def evaluate(
         self,
@@ -125,9 +132,9 @@ class HexapodMazeTask(MazeTaskBase, SpawnedWorkers):
     def _map(self, jobs: list) -> list[dict]:
         if self.in_process() or len(jobs) == 1:
             if self._local is None:
-                self._local = EpisodeRunner(self.world)
+                self._local = self.runner_type(self.world)
             return [_run(self._local, job) for job in jobs]
-        return list(self._pool(_init_worker, (self.world,)).map(_episode, jobs))
+        return list(self._pool(self.worker_init, (self.world,)).map(self.worker_episode, jobs))
 
 
 def _padded_traces(results: list[dict], n_cycles: int):

@@ -312,4 +312,3 @@ def default_out() -> Path:
 def _span(low: int, high: int) -> str:
     """``"10"`` or ``"5-10"``: a count that may differ between settings."""
     return str(low) if low == high else f"{low}-{high}"
-

@@ -12,7 +12,7 @@ from evorbc_ros.robots.hexapod import HexapodGeometry
 from evorbc_ros.sensors import SensorLayout
 from sim_bridge.hexapod.maze_world import DEFAULT_SENSORS
 from sim_bridge.hexapod.physics import PhysicsSettings
-from sim_bridge.robots.design import check_simulation, simulation_mismatch
+from sim_bridge.robots.design import check_controller_simulation
 from sim_bridge.robots.hexapod import describe_simulation
 
 
@@ -36,12 +36,6 @@ def check_controller(robot, controller) -> None:
             f"bridge simulates (config/{DEFAULT_SENSORS}: 25 beams over +-90 deg, grouped "
             "into 5)"
         )
-    bridge = describe_simulation(HexapodGeometry(), PhysicsSettings())
-    if controller.repertoire is not None:
-        check_simulation(controller.repertoire, bridge, controller.repertoire_path)
-    recorded = controller.spec.evolution.get("simulation")
-    mismatch = simulation_mismatch(recorded, bridge, "the controller")
-    if mismatch:
-        raise ConfigError(
-            f"{controller.arbitrator_path}: was evolved for a different robot ({mismatch})"
-        )
+    check_controller_simulation(
+        controller, describe_simulation(HexapodGeometry(), PhysicsSettings())
+    )

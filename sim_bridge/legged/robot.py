@@ -75,3 +75,15 @@ class LeggedRobot:
     def close(self) -> None:
         """Stop the worker processes."""
         self.pool.close()
+
+
+def simulated_robot(robot, workers: int | None = None) -> LeggedRobot:
+    """A legged registration's simulated robot (its ``simulation`` factory).
+
+    Args:
+        robot: the :class:`~evorbc_ros.robots.registry.Robot`; its ``model`` names the
+            settings file (:class:`~evorbc_ros.robots.builtin.legged.LeggedModel`).
+        workers: PyBullet worker processes (default: every core).
+
+    """
+    return LeggedRobot(str(robot.model.path()), workers=workers)

@@ -9,6 +9,7 @@ section 11). A kinematic robot (4WS) records none, and nothing is compared.
 
 from __future__ import annotations
 
+from evorbc_ros.config import ConfigError
 from evorbc_ros.json_files import first_difference
 from evorbc_ros.repertoire import Repertoire, RepertoireError
 
@@ -38,3 +39,25 @@ def check_simulation(
     )
     if mismatch:
         raise RepertoireError(f"{source}: was evolved for a different robot ({mismatch})")
+
+
+def check_controller_simulation(controller, simulation: dict) -> None:
+    """Refuse a controller whose repertoire or arbitrator was evolved for another design.
+
+    Args:
+        controller: the :class:`evorbc_ros.arbitration.Controller` ``evorbc-sim`` runs.
+        simulation: the design the bridge simulates (``describe()``).
+
+    Raises:
+        RepertoireError, ConfigError: one line naming the file and the first setting that
+            differs.
+
+    """
+    if controller.repertoire is not None:
+        check_simulation(controller.repertoire, simulation, controller.repertoire_path)
+    recorded = controller.spec.evolution.get("simulation")
+    mismatch = simulation_mismatch(recorded, simulation, "the controller")
+    if mismatch:
+        raise ConfigError(
+            f"{controller.arbitrator_path}: was evolved for a different robot ({mismatch})"
+        )
