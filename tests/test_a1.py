@@ -12,12 +12,12 @@ import numpy as np
 import pybullet as p
 import pytest
 from a1_helpers import a1_settings, trot_repertoire
-from maze_paths import solve
 
 from evorbc_ros.config import config_dir
 from evorbc_ros.legged_executor import LeggedExecutor
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.legged import LeggedGaitTable
+from offline_evolution.mazes.paths import solve
 from sim_bridge.legged.evaluate import HEADING, X, Y, evaluate_genes
 from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.maze import load_named_maze
