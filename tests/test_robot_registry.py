@@ -204,4 +204,4 @@ def test_the_names_are_live_choices():
     assert "hexapod" in registry.ROBOT_NAMES and "tank" not in registry.ROBOT_NAMES
     assert 5 not in registry.ROBOT_NAMES
     assert list(registry.ROBOT_NAMES) == [*BUILTIN, *FROM_FILES]
-    assert len(registry.ROBOT_NAMES) == 6
+    assert len(registry.ROBOT_NAMES) == 7

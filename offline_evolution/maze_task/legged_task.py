@@ -71,6 +71,8 @@ class LeggedMazeTask(HexapodMazeTask):
         """The robot's locomotion parameters (a standard controller's outputs)."""
         return self.robot.gait.parameter_specs()
 
+    #: No perturbed worlds yet (the hexapod's episode applies them; this one does not).
+    perturbation_family = None
     controller_type = LeggedController
     runner_type = EpisodeRunner
     worker_init = staticmethod(_init_worker)

@@ -144,8 +144,12 @@ class EpisodeRunner:
         maze_index: int,
         start: tuple[float, float, float],
         record: bool = False,
+        world: dict | None = None,
     ) -> dict:
         """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index``.
+
+        ``world`` must be None: perturbed worlds are the hexapod's so far (its maze task's
+        ``perturbation_family``); the argument keeps the tasks' job tuples one shape.
 
         Returns:
             ``{"reached", "fell", "cycles", "final_distance", "initial_distance"}`` and,
@@ -153,6 +157,8 @@ class EpisodeRunner:
             ``"outputs" (cycles, n_outputs)``.
 
         """
+        if world is not None:
+            raise ValueError("this legged robot's episodes take no perturbed world")
         maze = self.world.mazes[maze_index]
         sim = self.sim(maze_index)
         sim.reset(*start)
