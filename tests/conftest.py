@@ -1,5 +1,7 @@
 """Shared fixtures."""
 
+import signal
+
 import pytest
 from study_helpers import run_study, write_tiny_study
 
@@ -69,3 +71,27 @@ def serial_results(tmp_path_factory):
     assert result.returncode == 0, result.stderr
     assert "study tiny: 2 done, 0 running, 0 left" in result.stderr
     return folder / "results"
+
+
+@pytest.fixture(autouse=True)
+def _restore_signal_handlers():
+    """Give every test the SIGINT and SIGTERM handlers it started with.
+
+    A node's or a command's main run in this process ends by ignoring SIGINT (it is
+    finishing anyway); left so, every later subprocess would inherit SIG_IGN and shrug
+    off the Ctrl-C a test sends it.
+    """
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    # Whatever ran before (a test, or code run while collecting) must not have left them
+    # ignored: pytest's own are Python's defaults.
+    if saved[signal.SIGINT] is signal.SIG_IGN:
+        saved[signal.SIGINT] = signal.default_int_handler
+    if saved[signal.SIGTERM] is signal.SIG_IGN:
+        saved[signal.SIGTERM] = signal.SIG_DFL
+    for sig, handler in saved.items():
+        if handler is not None:
+            signal.signal(sig, handler)
+    yield
+    for sig, handler in saved.items():
+        if handler is not None:
+            signal.signal(sig, handler)

@@ -159,7 +159,7 @@ def test_the_report_comes_from_the_results_folder_alone(serial_results, tmp_path
     )
     assert result.returncode == 0, result.stderr
     text = (out / "tiny.md").read_text()
-    assert "* Runs finished: 2, 2-2 seeds per setting (the full protocol has 2)." in text
+    assert "* Runs finished: 2, 2 seeds per setting (the full protocol has 2)." in text
     assert "* NEAT generations per run: 12" in text
     record = json.loads((serial_results / "approach-evorbc" / "seed-001" / "run.json").read_text())
     best = [record["summary"]["best_fitness"]]
