@@ -4,7 +4,8 @@ One generation: build each genome's network, run every genome from every start i
 call of the task's ``evaluate`` (the 4WS maze task: one batched kernel call,
 :mod:`offline_evolution.maze_task.kernel`), assign the mean fitness, then let neat-python
 reproduce and speciate. Start poses are new every generation and the same for every genome
-of a generation, drawn from a generator seeded by ``(seed, generation)``.
+of a generation, drawn from a generator seeded by ``(seed, generation)``; so are the
+generated mazes of a task that trains on them (``training``, docs/design.md section 22).
 
 The task is anything that implements :class:`~offline_evolution.task_protocol.ArbitratorTask`
 (docs/design.md section 20): by default the maze task that ``settings.task`` describes for
@@ -187,6 +188,18 @@ class Evolution:
         if task is None:
             task = make_task(MazeTaskSettings(**settings.task), settings.robot, workers)
         self.task = task
+        # Held-out mazes refused, generated training mazes set up (maze tasks; a task of
+        # the caller's own may have neither).
+        start_training = getattr(task, "start_training", None)
+        if start_training is not None:
+            try:
+                start_training(settings.robot, settings.seed)
+            except ConfigError:
+                self.close()
+                raise
+        elif settings.task.get("training"):
+            self.close()
+            raise ConfigError("this task cannot train on generated mazes (no start_training)")
         # The simulated robot (PyBullet robots; None for the 4WS kinematics).
         self.simulation = self.task.describe()
         if settings.kind == "evorbc":
@@ -231,8 +244,15 @@ class Evolution:
         generation = self.population.generation
         specs = [network_spec(g, config) for _, g in genomes]
         rng = np.random.default_rng([self.settings.seed, generation])
-        starts = self.task.sample_starts(rng)
-        result = self.task.evaluate(specs, self.controller, starts)
+        episodes = getattr(self.task, "generation_episodes", None)
+        if episodes is None:  # a task of the caller's own: starts only
+            starts, world = self.task.sample_starts(rng), None
+        else:  # a maze task: with generated mazes and perturbed worlds if it trains on them
+            starts, world = episodes(rng)
+        if world is None:
+            result = self.task.evaluate(specs, self.controller, starts)
+        else:
+            result = self.task.evaluate(specs, self.controller, starts, world=world)
         fitness = result.fitness.reshape(len(specs), len(starts)).mean(axis=1)
         reached = result.reached.reshape(len(specs), len(starts)).sum(axis=1)
         for (_, genome), f in zip(genomes, fitness, strict=True):

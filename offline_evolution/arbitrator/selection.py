@@ -118,9 +118,17 @@ class PostEvaluation:
 
 
 def post_evaluation_starts(task: ArbitratorTask, seed: int, samples: int) -> np.ndarray:
-    """The task's nominal starts, then ``samples`` seeded draws of its random starts."""
+    """The task's nominal starts, then ``samples`` seeded draws of its random starts.
+
+    A maze task that trains on generated mazes adds ``samples`` starts in each of its
+    generated validation mazes (never the held-out set; docs/design.md section 22) and
+    makes them its current mazes.
+    """
     rng = np.random.default_rng([seed, POST_EVALUATION_STREAM])
     rows = [task.nominal_starts()] + [task.sample_starts(rng) for _ in range(samples)]
+    validation = getattr(task, "validation_starts", None)
+    if validation is not None:
+        rows.append(validation(rng, samples))
     return np.concatenate(rows)
 
 

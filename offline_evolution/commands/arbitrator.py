@@ -174,7 +174,9 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     from offline_evolution.arbitrator.neat_config import load_neat_config
     from offline_evolution.arbitrator.settings import load_run_settings
     from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+    from offline_evolution.maze_task.training import check_training
     from offline_evolution.memory import check_evolution_memory
+    from sim_bridge.maze import load_named_maze
 
     out = Path(args.out)
     plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")
@@ -194,6 +196,13 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         generations += lookup(robot).equal_budget_generations
     neat_file = Path(args.neat_config) if args.neat_config else run.neat_path()
     task_settings = MazeTaskSettings.load(args.task or run.task_path())
+    # Held-out mazes and seeds are refused before any work (docs/design.md section 22).
+    check_training(
+        [load_named_maze(n) for n in task_settings.mazes],
+        task_settings.training,
+        args.seed,
+        str(args.task or run.task_path()),
+    )
     settings = EvolutionSettings(
         kind=args.kind,
         robot=robot,

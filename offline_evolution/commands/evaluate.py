@@ -16,9 +16,8 @@ from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, ships
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
 from offline_evolution.commands.common import CliError, at_least, count
 from offline_evolution.commands.replay import check_task, controller_inputs
+from offline_evolution.mazes.held_out import HELD_OUT_SEED  # never trained on
 
-#: Seed of the held-out generated mazes: never used to train (docs/design.md section 21).
-HELD_OUT_SEED = 21021
 #: The suite word for the mazes the controller was trained on (its task's mazes).
 PAPER = "paper"
 

@@ -6,7 +6,9 @@ A controller's fitness in one episode is (paper eq. 5, docs/design.md section 4)
     1 - d_f / d_i      otherwise (final over initial distance to the target)
 
 and its fitness for selection is the mean over the task's episodes (one per maze by
-default, new random starts each generation).
+default, new random starts each generation). With a ``training`` setting, each generation
+also runs on newly drawn generated mazes (:mod:`~offline_evolution.maze_task.training`,
+docs/design.md section 22).
 
 :class:`MazeTaskBase` holds this; the 4WS task (:mod:`~offline_evolution.maze_task.task`)
 and the hexapod's (:mod:`~offline_evolution.maze_task.hexapod_task`) add how episodes run.
@@ -26,6 +28,7 @@ from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.sensors import SensorLayout
+from offline_evolution.maze_task.training import TrainingMazes, TrainingSettings, check_training
 from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.maze import Maze, load_named_maze
 from sim_bridge.robots.base import control_steps
@@ -45,6 +48,16 @@ class MazeTaskSettings:
     episode_time: float = setting(120.0, doc="episode length T (s)", minimum=0.1)
     samples_per_maze: int = setting(1, doc="random starts per maze per evaluation", minimum=1)
     sensors: str = setting("sensors/4ws.yaml", doc="sensor layout file, relative to config/")
+    # A frozen dataclass: the default call is a field declaration, not a shared value.
+    training: TrainingSettings | None = setting(  # noqa: RUF009
+        None, doc="training on generated mazes (docs/design.md section 22); none: the paper's"
+    )
+
+    def __post_init__(self):
+        # A recorded task (checkpoint, arbitrator file) holds ``training`` as a mapping.
+        if isinstance(self.training, dict):
+            training = TrainingSettings.from_dict(self.training, "the task's training")
+            object.__setattr__(self, "training", training)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> MazeTaskSettings:
@@ -68,6 +81,10 @@ class MazeTaskSettings:
         """
         if not isinstance(values, dict):
             raise ConfigError(f"{source}: expected a mapping of task settings")
+        values = dict(values)
+        training = values.pop("training", None)
+        if training is not None:
+            values["training"] = TrainingSettings.from_dict(training, source)
         settings = build_settings(cls, values, source)
         try:
             control_steps(settings.episode_time, CONTROL_PERIOD)
@@ -93,13 +110,16 @@ class MazeTaskSettings:
         return settings
 
     def as_dict(self) -> dict:
-        """Plain-data form (recorded in arbitrator files)."""
-        return {
+        """Plain-data form (recorded in arbitrator files); ``training`` only when set."""
+        out = {
             "mazes": list(self.mazes),
             "episode_time": self.episode_time,
             "samples_per_maze": self.samples_per_maze,
             "sensors": self.sensors,
         }
+        if self.training is not None:
+            out["training"] = self.training.as_dict()
+        return out
 
 
 def eq5_fitness(reached, seconds, final, initial, episode_time: float) -> np.ndarray:
@@ -144,7 +164,13 @@ class MazeTaskBase(abc.ABC):
 
     def __init__(self, settings: MazeTaskSettings, dt: float, footprint_radius: float):
         self.settings = settings
-        self.mazes: list[Maze] = [load_named_maze(name) for name in settings.mazes]
+        #: The task's own mazes (``settings.mazes``), always first in :attr:`mazes`.
+        self.task_mazes: tuple[Maze, ...] = tuple(load_named_maze(n) for n in settings.mazes)
+        #: The mazes episodes run in (start rows' maze column): the task's own, then the
+        #: generated ones of the current draw (:meth:`generation_episodes`).
+        self.mazes: list[Maze] = list(self.task_mazes)
+        #: The generated mazes drawn from (:meth:`start_training`), or None.
+        self.training: TrainingMazes | None = None
         self.layout = SensorLayout.load(config_dir() / settings.sensors)
         self.dt = dt
         self.n_cycles = control_steps(settings.episode_time, dt)
@@ -182,16 +208,88 @@ class MazeTaskBase(abc.ABC):
         return len(self.parameter_specs)
 
     def sample_starts(self, rng: np.random.Generator) -> np.ndarray:
-        """``(n_mazes * samples_per_maze, 4)`` rows ``(maze, x, y, heading)``."""
+        """``(n_task_mazes * samples_per_maze, 4)`` rows ``(maze, x, y, heading)``.
+
+        The task's own mazes (``settings.mazes``), never the generated ones.
+        """
         rows = []
-        for k, maze in enumerate(self.mazes):
+        for k, maze in enumerate(self.task_mazes):
             poses = maze.sample_starts(rng, self.settings.samples_per_maze, self.footprint_radius)
             rows += [(k, *p) for p in poses]
         return np.array(rows, dtype=np.float64)
 
     def nominal_starts(self) -> np.ndarray:
-        """One row ``(maze, x, y, heading)`` per maze at its nominal start pose."""
-        return np.array([(k, *m.start_pose) for k, m in enumerate(self.mazes)])
+        """One row ``(maze, x, y, heading)`` per task maze at its nominal start pose."""
+        return np.array([(k, *m.start_pose) for k, m in enumerate(self.task_mazes)])
+
+    # -- training on generated mazes (docs/design.md section 22) -----------------------
+
+    def start_training(self, robot: str, seed: int, source: str = "the task") -> None:
+        """Prepare a run of seed ``seed``: refuse held-out mazes, set up generated ones.
+
+        Args:
+            robot: the registered robot the generated mazes are made for.
+            source: how errors name the task (its file).
+
+        Raises:
+            ConfigError: a held-out maze or seed (:func:`~offline_evolution.maze_task.
+                training.check_training`).
+        """
+        check_training(self.task_mazes, self.settings.training, seed, source)
+        if self.settings.training is not None:
+            self.training = TrainingMazes(self.settings.training, robot)
+
+    def use_mazes(self, generated: list[Maze]) -> None:
+        """Run episodes in the task's mazes and ``generated`` (rows ``n_task_mazes`` on)."""
+        self.mazes = list(self.task_mazes) + list(generated)
+        self.mazes_changed(len(self.task_mazes))
+
+    def mazes_changed(self, unchanged: int) -> None:  # noqa: B027 - optional hook
+        """Hook: :attr:`mazes` changed after its first ``unchanged`` entries (4WS: repack).
+
+        PyBullet tasks need nothing here: their jobs carry generated mazes.
+        """
+
+    def _rows(self, rng: np.random.Generator, first: int, per_maze: int) -> list[np.ndarray]:
+        """Random start rows of :attr:`mazes` from ``first`` on, ``per_maze`` in each."""
+        rows = []
+        for k in range(first, len(self.mazes)):
+            poses = self.mazes[k].sample_starts(rng, per_maze, self.footprint_radius)
+            rows.append(np.column_stack([np.full(per_maze, float(k)), poses]))
+        return rows
+
+    def generation_episodes(self, rng: np.random.Generator):
+        """One generation's ``(starts (S, 4), world)``, drawn only from ``rng``.
+
+        Without ``training``: :meth:`sample_starts` and no perturbed world (the paper's
+        protocol, unchanged). With it: K generated mazes (made the current ones), the
+        task's mazes' starts unless ``task_mazes`` is false, S starts in each generated
+        maze, then the worlds of ``perturb`` (one per row, start errors applied) or None.
+        """
+        if self.training is None:
+            return self.sample_starts(rng), None
+        t = self.training
+        self.use_mazes(t.mazes(t.training_indices(rng)))
+        rows = [self.sample_starts(rng)] if t.settings.task_mazes else []
+        rows += self._rows(rng, len(self.task_mazes), t.settings.starts)
+        starts = np.concatenate(rows)
+        if not t.perturbed:
+            return starts, None
+        world = t.perturbation.draw(rng, len(starts))
+        return world.shift_starts(starts, self.mazes, self.footprint_radius), world
+
+    def validation_starts(self, rng: np.random.Generator, samples: int) -> np.ndarray:
+        """Post-selection rows in generated validation mazes, ``samples`` in each.
+
+        ``(post_mazes * samples, 4)``, drawn from ``rng`` after the task mazes' rows;
+        ``(0, 4)`` without ``training`` (the task's own mazes only, as the paper's).
+        """
+        if self.training is None or not self.training.settings.post_mazes or samples < 1:
+            self.use_mazes([])
+            return np.zeros((0, 4))
+        t = self.training
+        self.use_mazes(t.mazes(t.validation_indices(rng)))
+        return np.concatenate(self._rows(rng, len(self.task_mazes), samples))
 
     def fitness(self, reached, cycles, final, initial) -> np.ndarray:
         """Eq. 5 for each episode."""

@@ -45,6 +45,7 @@ from sim_bridge.hexapod.maze_world import FALLEN_TILT
 from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings
 from sim_bridge.hexapod.scanner import Scanner
 from sim_bridge.maze import Maze
+from sim_bridge.maze_sims import MazeSims
 from sim_bridge.quiet_pybullet import p
 
 
@@ -180,7 +181,8 @@ class EpisodeRunner:
         self.scanner = world.scanner()
         self.laser = LaserToRangefinders(world.layout.rangefinders)
         self.goal = GoalInputs(world.layout)
-        self.sims: dict[int, HexapodSim] = {}
+        w = world
+        self.sims = MazeSims(w.mazes, lambda boxes: HexapodSim(w.geometry, w.physics, boxes))
         self.choosers: dict[str, _Chooser] = {}
         self.per_period = world.physics.steps(world.geometry.control_period)
         self.dt = world.physics.dt  # s per physics step, the gait clock's tick
@@ -191,12 +193,9 @@ class EpisodeRunner:
             self.choosers = {controller.key: _Chooser(controller, self.world.geometry)}
         return self.choosers[controller.key]
 
-    def sim(self, maze: int) -> HexapodSim:
-        """The simulation of maze ``maze`` (built on first use)."""
-        if maze not in self.sims:
-            w = self.world
-            self.sims[maze] = HexapodSim(w.geometry, w.physics, w.mazes[maze].boxes)
-        return self.sims[maze]
+    def sim(self, maze: int | Maze) -> HexapodSim:
+        """The simulation of task maze ``maze`` or of a generated maze (built on first use)."""
+        return self.sims.get(maze)[1]
 
     def inputs(
         self,
@@ -225,12 +224,12 @@ class EpisodeRunner:
         self,
         network: NetworkSpec,
         controller: HexapodController,
-        maze_index: int,
+        maze_index: int | Maze,
         start: tuple[float, float, float],
         record: bool = False,
         world: dict | None = None,
     ) -> dict:
-        """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index``.
+        """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index`` (or a Maze).
 
         ``world``: a perturbed world's row (:func:`perturbed_sim`), or None.
 
@@ -240,8 +239,7 @@ class EpisodeRunner:
             ``"outputs" (cycles, n_outputs)``.
 
         """
-        maze = self.world.mazes[maze_index]
-        sim = self.sim(maze_index)
+        maze, sim = self.sims.get(maze_index)  # a task maze's index or a generated maze
         sim.reset(*start)
         net = network.compile()
         chooser = self.chooser(controller)

@@ -116,7 +116,14 @@ class HexapodMazeTask(MazeTaskBase, SpawnedWorkers):
         """
         rows = [world.row(k) if world is not None else None for k in range(len(starts))]
         jobs = [
-            (net.to_dict(), controller, int(row[0]), tuple(map(float, row[1:4])), record, w)
+            (
+                net.to_dict(),
+                controller,
+                self._job_maze(row[0]),
+                tuple(map(float, row[1:4])),
+                record,
+                w,
+            )
             for net in networks
             for row, w in zip(starts, rows, strict=True)
         ]
@@ -128,6 +135,15 @@ class HexapodMazeTask(MazeTaskBase, SpawnedWorkers):
         fell = np.array([r["fell"] for r in results], dtype=bool)
         traces = _padded_traces(results, self.n_cycles) if record else None
         return self.episode_result(reached, cycles, final, initial, traces, fell)
+
+    def _job_maze(self, column: float):
+        """How a job names maze ``column``: by index or, if generated, the maze itself.
+
+        The workers hold the task's own mazes; generated ones are new every generation
+        (docs/design.md section 22), so their jobs carry them.
+        """
+        k = int(column)
+        return k if k < len(self.task_mazes) else self.mazes[k]
 
     def _map(self, jobs: list) -> list[dict]:
         if self.in_process() or len(jobs) == 1:

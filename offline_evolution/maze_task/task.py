@@ -9,6 +9,7 @@ Settings, mazes, start poses and eq. 5 fitness are every maze task's
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from typing import NamedTuple
 
 import numba
@@ -25,7 +26,7 @@ from offline_evolution.maze_task.base import (
     eq5_fitness,
 )
 from offline_evolution.maze_task.kernel import EVORBC, STANDARD, run_episodes
-from offline_evolution.maze_task.world import pack_mazes
+from offline_evolution.maze_task.world import MazePiece, combine_pieces, maze_piece
 from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.robots.diff_drive import DiffDriveRobot
 from sim_bridge.robots.four_ws import FourWSRobot
@@ -33,6 +34,10 @@ from sim_bridge.sensors import compile_layout
 
 #: A robot whose compiled motion model the episode kernel runs.
 KinematicRobot = FourWSRobot | DiffDriveRobot
+
+#: Generated mazes whose packed walls and grids a task keeps (as many as the training
+#: draw keeps of the mazes themselves, :data:`offline_evolution.maze_task.training.CACHE`).
+_PIECES = 512
 
 #: Episodes handed to a worker thread at a time: small enough to balance episodes that end
 #: early (target reached) against ones that run the full 120 s.
@@ -134,7 +139,29 @@ class MazeTask(MazeTaskBase):
         self.sensors = compile_layout(self.layout)
         # Walls a ray or the footprint can touch from a cell: sensor reach plus a step and
         # a margin (m).
-        self.pack = pack_mazes(self.mazes, reach=self.sensors.reach() + 0.1)
+        self.reach = self.sensors.reach() + 0.1
+        self._pieces = [maze_piece(m, self.reach) for m in self.mazes]
+        self._generated_pieces: OrderedDict[str, MazePiece] = OrderedDict()
+        self.pack = combine_pieces(self._pieces)
+
+    def mazes_changed(self, unchanged: int) -> None:
+        """Repack for a new set of mazes: only mazes not packed before get new grids.
+
+        The pack's arrays keep their types (only their lengths change), so the compiled
+        kernel runs on it without compiling again (docs/design.md section 22).
+        """
+        pieces = self._pieces[:unchanged]
+        for maze in self.mazes[unchanged:]:
+            piece = self._generated_pieces.get(maze.name)
+            if piece is None:
+                piece = maze_piece(maze, self.reach)
+                self._generated_pieces[maze.name] = piece
+                if len(self._generated_pieces) > _PIECES:
+                    self._generated_pieces.popitem(last=False)
+            else:
+                self._generated_pieces.move_to_end(maze.name)
+            pieces.append(piece)
+        self.pack = combine_pieces(pieces)
 
     @property
     def parameter_specs(self) -> tuple:

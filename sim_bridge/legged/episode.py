@@ -38,6 +38,7 @@ from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.legged.scanner import Scanner
 from sim_bridge.legged.settings import LeggedRobotSettings
 from sim_bridge.maze import Maze
+from sim_bridge.maze_sims import MazeSims
 
 
 @dataclass(frozen=True)
@@ -102,7 +103,8 @@ class EpisodeRunner:
         self.scanner = world.scanner()
         self.laser = LaserToRangefinders(world.layout.rangefinders)
         self.goal = GoalInputs(world.layout)
-        self.sims: dict[int, LeggedSim] = {}
+        w = world
+        self.sims = MazeSims(w.mazes, lambda boxes: LeggedSim(w.settings, boxes))
         self.choosers: dict[str, _Chooser] = {}
         physics = world.settings.physics
         self.per_period = physics.steps(world.settings.control_period)
@@ -115,12 +117,9 @@ class EpisodeRunner:
             self.choosers = {controller.key: _Chooser(controller, self.world.settings)}
         return self.choosers[controller.key]
 
-    def sim(self, maze: int) -> LeggedSim:
-        """The simulation of maze ``maze`` (built on first use)."""
-        if maze not in self.sims:
-            w = self.world
-            self.sims[maze] = LeggedSim(w.settings, w.mazes[maze].boxes)
-        return self.sims[maze]
+    def sim(self, maze: int | Maze) -> LeggedSim:
+        """The simulation of task maze ``maze`` or of a generated maze (built on first use)."""
+        return self.sims.get(maze)[1]
 
     def inputs(self, sim: LeggedSim, maze: Maze, base: tuple | None = None) -> np.ndarray:
         """The arbitrator's inputs now: laser groups, then goal bearing.
@@ -141,12 +140,12 @@ class EpisodeRunner:
         self,
         network: NetworkSpec,
         controller: LeggedController,
-        maze_index: int,
+        maze_index: int | Maze,
         start: tuple[float, float, float],
         record: bool = False,
         world: dict | None = None,
     ) -> dict:
-        """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index``.
+        """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index`` (or a Maze).
 
         ``world`` must be None: perturbed worlds are the hexapod's so far (its maze task's
         ``perturbation_family``); the argument keeps the tasks' job tuples one shape.
@@ -159,8 +158,7 @@ class EpisodeRunner:
         """
         if world is not None:
             raise ValueError("this legged robot's episodes take no perturbed world")
-        maze = self.world.mazes[maze_index]
-        sim = self.sim(maze_index)
+        maze, sim = self.sims.get(maze_index)  # a task maze's index or a generated maze
         sim.reset(*start)
         net = network.compile()
         chooser = self.chooser(controller)

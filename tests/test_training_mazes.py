@@ -1,0 +1,236 @@
+"""Training on generated mazes (issue 21 item 2, docs/design.md section 22).
+
+Fresh draws and pools, the same draw for every genome, exact resume, held-out refusals,
+validation mazes in the post-selection, and the 4WS kernel taking a new set of mazes
+every generation without compiling again.
+"""
+
+import numpy as np
+import pytest
+import yaml
+from conftest import SMALL_TASK
+
+from evorbc_ros.config import ConfigError
+from offline_evolution.arbitrator.evolve import EvolutionSettings, evolve, file_sha256
+from offline_evolution.arbitrator.selection import post_evaluation_starts
+from offline_evolution.checkpoint import Interrupted
+from offline_evolution.maze_task import kernel
+from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
+from offline_evolution.maze_task.training import TrainingSettings
+from offline_evolution.maze_task.world import pack_mazes
+from offline_evolution.mazes.generator import generate_maze, spec_for_robot
+
+TRAINING = {"generated": 2, "starts": 1, "pool": 0, "maze_seed": 5, "post_mazes": 2}
+
+
+def task_dict(**training):
+    return {**SMALL_TASK, "training": {**TRAINING, **training}}
+
+
+def run_settings(neat_file, repertoire, task, seed=3, generations=4):
+    return EvolutionSettings(
+        kind="evorbc",
+        robot="4ws-5",
+        generations=generations,
+        seed=seed,
+        neat_file=str(neat_file),
+        neat_sha256=file_sha256(neat_file),
+        task=task,
+        mapping="polar",
+        repertoire_fingerprint=repertoire.fingerprint(),
+        hall_of_fame=3,
+        post_samples=1,
+    )
+
+
+def training_task(**training) -> MazeTask:
+    task = MazeTask(MazeTaskSettings.from_dict(task_dict(**training), "t.yaml"), "4ws-5")
+    task.start_training("4ws-5", seed=3)
+    return task
+
+
+def histories(result):
+    out = []
+    for h in result.history:
+        d = h.as_dict()
+        d.pop("seconds"), d.pop("evaluation_seconds")
+        out.append(d)
+    return out
+
+
+def test_generations_draw_new_proven_mazes_seeded_by_generation():
+    task = training_task()
+    starts, world = task.generation_episodes(np.random.default_rng([3, 0]))
+    assert world is None
+    first = [m.name for m in task.mazes]
+    # The task's two mazes (one start each), then 2 generated mazes x 1 start.
+    assert first[:2] == ["obstacle", "gaps"] and len(first) == 4
+    assert all(n.startswith("train5-") for n in first[2:])
+    assert starts[:, 0].tolist() == [0, 1, 2, 3]
+    task.generation_episodes(np.random.default_rng([3, 1]))
+    assert [m.name for m in task.mazes][2:] != first[2:]  # fresh mazes the next generation
+    again, _ = task.generation_episodes(np.random.default_rng([3, 0]))
+    assert [m.name for m in task.mazes] == first and np.array_equal(again, starts)
+    # Each is the generator's maze of that seed and index: proven solvable by it.
+    index = int(first[2].split("-")[1])
+    made = generate_maze(spec_for_robot("4ws-5"), 5, index, "train").maze
+    assert np.array_equal(made.walls, task.mazes[2].walls)
+
+
+def test_a_pool_samples_its_own_mazes_and_validation_uses_others():
+    task = training_task(pool=6, generated=3, starts=2)
+    seen = set()
+    for g in range(8):
+        starts, _ = task.generation_episodes(np.random.default_rng([3, g]))
+        names = [m.name for m in task.mazes[2:]]
+        assert len(set(names)) == 3 and len(starts) == 2 + 3 * 2
+        seen.update(int(n.split("-")[1]) for n in names)
+    assert seen <= set(range(6)) and len(seen) > 3
+    rows = post_evaluation_starts(task, seed=3, samples=2)
+    validation = [int(m.name.split("-")[1]) for m in task.mazes[2:]]
+    assert len(validation) == 2 and min(validation) >= 6  # never a pool maze
+    # Nominal starts, 2 x the task mazes' random starts, 2 starts per validation maze.
+    assert rows[:, 0].tolist() == [0, 1, 0, 1, 0, 1, 2, 2, 3, 3]
+
+
+def test_task_mazes_can_be_left_out_and_training_can_be_perturbed(small_repertoire):
+    task = training_task(task_mazes=False, perturb="realistic", starts=3)
+    starts, world = task.generation_episodes(np.random.default_rng([1, 2]))
+    assert sorted(set(starts[:, 0].astype(int))) == [2, 3] and len(world) == len(starts) == 6
+    controller = task.controller("evorbc", small_repertoire, "polar")
+    result = task.evaluate([_net()], controller, starts, world=world)
+    assert len(result.reached) == 6
+    # The nominal starts (post-selection, nominal watch) stay the task's own mazes.
+    assert task.nominal_starts()[:, 0].tolist() == [0, 1]
+
+
+def test_kernel_takes_new_mazes_without_compiling_or_repacking_old_ones(small_repertoire):
+    task = training_task(generated=3)
+    controller = task.controller("evorbc", small_repertoire, "polar")
+    net = _net()
+    task.evaluate([net], controller, task.nominal_starts())
+    compiled = len(kernel.run_episodes.signatures)
+    fixed = task._pieces
+    for g in range(3):
+        starts, _ = task.generation_episodes(np.random.default_rng([9, g]))
+        task.evaluate([net], controller, starts)
+        # The pack is what packing every current maze from scratch gives.
+        fresh = pack_mazes(task.mazes, task.reach)
+        for name in fresh._fields:
+            a, b = getattr(fresh, name), getattr(task.pack, name)
+            assert np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b, name
+    assert len(kernel.run_episodes.signatures) == compiled  # no new compilation
+    assert task._pieces is fixed and len(task._generated_pieces) == 9
+    # A maze drawn again reuses its packed grid instead of building it again.
+    again = task._generated_pieces[task.mazes[2].name]
+    task.use_mazes(task.mazes[2:3])
+    assert task._generated_pieces[task.mazes[2].name] is again
+
+
+def _tiny_network():
+    """A network of the 4ws layout's 10 inputs driving 2 outputs through constant biases."""
+    from evorbc_ros.config import config_dir
+    from evorbc_ros.sensors import SensorLayout
+
+    n = SensorLayout.load(config_dir() / "sensors/4ws.yaml").n_inputs
+    return {
+        "inputs": [-(k + 1) for k in range(n)],
+        "outputs": [0, 1],
+        "nodes": [
+            {"key": 0, "bias": 0.3, "response": 1.0, "activation": "sigmoid", "aggregation": "sum"},
+            {"key": 1, "bias": 0.8, "response": 1.0, "activation": "sigmoid", "aggregation": "sum"},
+        ],
+        "connections": [{"source": -1, "target": 0, "weight": 0.5, "enabled": True}],
+    }
+
+
+def test_every_genome_sees_the_same_draw_and_resume_is_exact(
+    tmp_path, small_neat_file, small_repertoire
+):
+    s = run_settings(small_neat_file, small_repertoire, task_dict(pool=0))
+    straight = evolve(s, small_repertoire)
+    ckpt = tmp_path / "run.checkpoint.json"
+    polls = []
+    with pytest.raises(Interrupted):
+        evolve(
+            s,
+            small_repertoire,
+            checkpoint=ckpt,
+            checkpoint_every=100,
+            should_stop=lambda: polls.append(1) or len(polls) == 2,
+        )
+    resumed = evolve(s, small_repertoire, checkpoint=ckpt)
+    assert histories(resumed) == histories(straight)
+    assert resumed.best_network == straight.best_network
+    assert resumed.selected_network == straight.selected_network
+    # The paper protocol on the same mazes gives another run: the generated mazes count.
+    paper = evolve(
+        run_settings(small_neat_file, small_repertoire, dict(SMALL_TASK)), small_repertoire
+    )
+    assert histories(paper) != histories(straight)
+
+
+def test_every_genome_of_a_generation_runs_the_same_draw(small_neat_file, small_repertoire):
+    """One evaluate() call per generation, all genomes from the same rows and mazes."""
+    calls = []
+
+    class Spy(MazeTask):
+        def evaluate(self, networks, controller, starts, record=False, world=None):
+            calls.append((len(networks), starts.copy(), [m.name for m in self.mazes]))
+            return super().evaluate(networks, controller, starts, record, world)
+
+    s = run_settings(small_neat_file, small_repertoire, task_dict(), generations=3)
+    task = Spy(MazeTaskSettings(**s.task), "4ws-5")
+    evolve(s, small_repertoire, task=task)
+    training = calls[:1] + [c for c in calls[1:] if c[0] == 24]
+    assert len(training) == 3 and all(n == 24 for n, _, _ in training)  # every genome
+    for g, (_, starts, names) in enumerate(training):
+        expected, _ = training_task().generation_episodes(np.random.default_rng([3, g]))
+        assert np.array_equal(starts, expected) and names[2:] != calls[0][2][2:] or g == 0
+
+
+def _net():
+    from evorbc_ros.network import NetworkSpec
+
+    return NetworkSpec.from_dict(_tiny_network())
+
+
+@pytest.mark.parametrize(
+    ("training", "message"),
+    [
+        ({"maze_seed": 21021}, "maze_seed 21021 is the held-out mazes' seed"),
+        ({"pool": 1}, "pool 1 holds fewer mazes than generated 2"),
+        ({"generated": 0}, "generated must be >= 1"),
+        ({"perturb": "nosuch"}, "perturb: unknown perturbation set 'nosuch'"),
+        ({"pools": 3}, "unknown setting 'pools' \\(did you mean 'pool'\\?\\)"),
+    ],
+)
+def test_bad_training_settings_are_one_line_errors(tmp_path, training, message):
+    path = tmp_path / "task.yaml"
+    path.write_text(yaml.safe_dump(task_dict(**training)))
+    with pytest.raises(ConfigError, match=message) as info:
+        MazeTaskSettings.load(path)
+    assert str(path) in str(info.value) and "\n" not in str(info.value)
+
+
+def test_training_refuses_the_held_out_seed_and_held_out_maze_files(tmp_path):
+    task = MazeTask(MazeTaskSettings.from_dict(task_dict(), "t"), "4ws-5")
+    with pytest.raises(ConfigError, match="--seed 21021 is the held-out mazes' seed"):
+        task.start_training("4ws-5", 21021)
+    task.start_training("4ws-5", 21022)  # any other seed is fine
+    from offline_evolution.mazes.files import save_maze
+
+    held = generate_maze(spec_for_robot("4ws-5"), 21021, 4).maze
+    save_maze(held, tmp_path / "held.yaml")
+    values = {**SMALL_TASK, "mazes": ["obstacle", str(tmp_path / "held.yaml")]}
+    paper = MazeTask(MazeTaskSettings.from_dict(values, "t.yaml"), "4ws-5")
+    with pytest.raises(ConfigError, match="t.yaml: mazes: gen21021-004 is a held-out maze"):
+        paper.start_training("4ws-5", 1, source="t.yaml")
+
+
+def test_settings_record_training_only_when_set():
+    assert "training" not in MazeTaskSettings.from_dict(dict(SMALL_TASK), "t").as_dict()
+    s = MazeTaskSettings.from_dict(task_dict(), "t")
+    assert isinstance(s.training, TrainingSettings)
+    again = MazeTaskSettings(**s.as_dict())  # as a checkpoint restores it
+    assert again.training == s.training and again.as_dict() == s.as_dict()
