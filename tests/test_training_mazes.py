@@ -234,3 +234,65 @@ def test_settings_record_training_only_when_set():
     assert isinstance(s.training, TrainingSettings)
     again = MazeTaskSettings(**s.as_dict())  # as a checkpoint restores it
     assert again.training == s.training and again.as_dict() == s.as_dict()
+
+
+class _FakeSim:
+    def __init__(self, boxes):
+        self.boxes, self.closed = boxes, False
+
+    def close(self):
+        self.closed = True
+
+
+def test_a_worker_keeps_a_few_generated_mazes_simulations():
+    from sim_bridge.maze_sims import KEEP, MazeSims
+
+    spec = spec_for_robot("4ws-5")
+    own = [generate_maze(spec, 7, 0).maze]
+    sims = MazeSims(own, _FakeSim)
+    maze, sim = sims.get(0)
+    assert maze is own[0] and sims.get(0)[1] is sim  # a task maze: by index, kept
+    made = []
+    for k in range(KEEP + 1):
+        m = generate_maze(spec, 7, k + 1).maze
+        got, s = sims.get(m)
+        assert got is m and np.array_equal(s.boxes, m.boxes)
+        made.append(s)
+    assert made[0].closed and not any(s.closed for s in made[1:])  # the oldest closed
+    assert len(sims.values()) == KEEP + 1 and not sim.closed
+
+
+def test_hexapod_episodes_in_a_generated_maze_match_the_maze_as_a_file(tmp_path):
+    """A generated maze sent with the job runs the episode its saved file runs."""
+    from evorbc_ros.arbitrator import ArbitratorFile
+    from evorbc_ros.defaults import default_arbitrator, default_repertoire
+    from evorbc_ros.repertoire import Repertoire
+    from offline_evolution.maze_task.task import make_task
+    from offline_evolution.mazes.files import save_maze
+
+    arb = ArbitratorFile.load(default_arbitrator("hexapod"))
+    repertoire = Repertoire.load(default_repertoire("hexapod"))
+    values = {"mazes": ["hexapod"], "episode_time": 2.0, "sensors": "sensors/hexapod.yaml"}
+    training = {"generated": 1, "starts": 1, "task_mazes": False, "maze_seed": 3}
+    task = make_task(
+        MazeTaskSettings.from_dict({**values, "training": training}, "t"), "hexapod", 1
+    )
+    try:
+        task.start_training("hexapod", 1)
+        starts, _ = task.generation_episodes(np.random.default_rng([1, 0]))
+        assert starts[:, 0].tolist() == [1]  # the generated maze, after the task's own
+        controller = task.controller("evorbc", repertoire, arb.mapping)
+        generated = task.evaluate([arb.network], controller, starts)
+        save_maze(task.mazes[1], tmp_path / "g.yaml")
+    finally:
+        task.close()
+    values["mazes"] = [str(tmp_path / "g.yaml")]
+    plain = make_task(MazeTaskSettings.from_dict(values, "t"), "hexapod", 1)
+    try:
+        rows = starts.copy()
+        rows[:, 0] = 0
+        from_file = plain.evaluate([arb.network], controller, rows)
+    finally:
+        plain.close()
+    assert generated.final_distance[0] == from_file.final_distance[0]
+    assert generated.cycles[0] == from_file.cycles[0] == 20
