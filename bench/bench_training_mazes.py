@@ -132,7 +132,7 @@ def main() -> int:
         base = base or total
         print(
             f"  {label:32s} {total:6.2f} s/generation (episodes {episodes:6.2f} s)  "
-            f"x{total / base:4.2f}   kernel compilations {compiled}"
+            f"x{total / base:4.2f}   new kernel signatures {compiled}"
         )
     return 0
 
