@@ -78,18 +78,28 @@ def check_evolution_memory(
     """
     mazes = len(task.mazes)
     per_episode = lookup(robot).episode_bytes
-    generation = pop_size * mazes * task.samples_per_maze
-    post = post_candidates * mazes * (post_samples + 1)
+    # Generated training mazes (docs/design.md section 22) add K x S episodes a genome and
+    # post_mazes x post_samples to each post-evaluated genome.
+    training = task.training
+    own = mazes * task.samples_per_maze if training is None or training.task_mazes else 0
+    extra = training.generated * training.starts if training is not None else 0
+    generation = pop_size * (own + extra)
+    post_extra = training.post_mazes * post_samples if training is not None else 0
+    post = post_candidates * (mazes * (post_samples + 1) + post_extra)
+    where = f"{mazes} mazes x {task.samples_per_maze} starts"
+    if training is not None:
+        where = f"({where} + {training.generated} generated mazes x {training.starts})"
     check_memory(
         BASE_BYTES + per_episode * generation,
         f"{source}: samples_per_maze {task.samples_per_maze} ({generation:,} episodes a "
-        f"generation: {pop_size} genomes x {mazes} mazes x {task.samples_per_maze} starts)",
+        f"generation: {pop_size} genomes x {where})",
         "lower samples_per_maze, the number of mazes or pop_size",
     )
     check_memory(
         BASE_BYTES + per_episode * post,
         f"the post-evaluation ({post:,} episodes: {post_candidates} genomes x {mazes} mazes "
-        f"x {post_samples + 1} starts)",
+        f"x {post_samples + 1} starts"
+        + (f" + {post_extra} in validation mazes)" if post_extra else ")"),
         "lower post_samples or hall_of_fame",
     )
 

@@ -296,3 +296,18 @@ def test_hexapod_episodes_in_a_generated_maze_match_the_maze_as_a_file(tmp_path)
         plain.close()
     assert generated.final_distance[0] == from_file.final_distance[0]
     assert generated.cycles[0] == from_file.cycles[0] == 20
+
+
+def test_generated_episodes_count_in_the_memory_check(monkeypatch):
+    from offline_evolution import memory
+
+    monkeypatch.setattr(memory, "machine_memory", lambda: 24 << 30)
+    settings = MazeTaskSettings.from_dict(task_dict(generated=20, starts=50000), "t.yaml")
+    memory.check_evolution_memory(
+        MazeTaskSettings.from_dict(dict(SMALL_TASK), "t"), 150, "4ws-5", "t", 75, 10
+    )
+    with pytest.raises(ConfigError) as info:
+        memory.check_evolution_memory(settings, 150, "4ws-5", "t.yaml", 75, 10)
+    message = str(info.value)
+    assert "150 genomes x (2 mazes x 1 starts + 20 generated mazes x 50000)" in message
+    assert message.startswith("t.yaml: samples_per_maze 1 (150,000,300 episodes a generation")
