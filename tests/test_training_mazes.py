@@ -311,3 +311,11 @@ def test_generated_episodes_count_in_the_memory_check(monkeypatch):
     message = str(info.value)
     assert "150 genomes x (2 mazes x 1 starts + 20 generated mazes x 50000)" in message
     assert message.startswith("t.yaml: samples_per_maze 1 (150,000,300 episodes a generation")
+
+
+@pytest.mark.parametrize("name", ["maze-4ws-generated.yaml", "maze-hexapod-generated.yaml"])
+def test_shipped_generated_training_tasks_load(name):
+    from evorbc_ros.config import config_dir
+
+    settings = MazeTaskSettings.load(config_dir() / "tasks" / name)
+    assert settings.training is not None and settings.training.maze_seed != 21021
