@@ -319,3 +319,11 @@ def test_shipped_generated_training_tasks_load(name):
 
     settings = MazeTaskSettings.load(config_dir() / "tasks" / name)
     assert settings.training is not None and settings.training.maze_seed != 21021
+
+
+def test_perturbed_training_needs_a_simulation_that_takes_perturbations():
+    task = MazeTask(MazeTaskSettings.from_dict(task_dict(perturb="realistic"), "t"), "4ws-5")
+    task.start_training("4ws-5", 1, source="t.yaml")  # the kinematic kernel takes them
+    task.perturbation_family = None  # as a legged robot's task without perturbed worlds
+    with pytest.raises(ConfigError, match="t.yaml: training: perturb realistic: 4ws-5's"):
+        task.start_training("4ws-5", 1, source="t.yaml")

@@ -233,11 +233,18 @@ class MazeTaskBase(abc.ABC):
 
         Raises:
             ConfigError: a held-out maze or seed (:func:`~offline_evolution.maze_task.
-                training.check_training`).
+                training.check_training`), or perturbed training for a simulation that
+                takes no perturbed worlds.
         """
         check_training(self.task_mazes, self.settings.training, seed, source)
         if self.settings.training is not None:
-            self.training = TrainingMazes(self.settings.training, robot)
+            training = TrainingMazes(self.settings.training, robot)
+            if training.perturbed and getattr(self, "perturbation_family", None) is None:
+                raise ConfigError(
+                    f"{source}: training: perturb {training.perturbation.name}: {robot}'s "
+                    "simulation takes no perturbed worlds (use none)"
+                )
+            self.training = training
 
     def use_mazes(self, generated: list[Maze]) -> None:
         """Run episodes in the task's mazes and ``generated`` (rows ``n_task_mazes`` on)."""
