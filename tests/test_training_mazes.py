@@ -182,11 +182,14 @@ def test_every_genome_of_a_generation_runs_the_same_draw(small_neat_file, small_
     s = run_settings(small_neat_file, small_repertoire, task_dict(), generations=3)
     task = Spy(MazeTaskSettings(**s.task), "4ws-5")
     evolve(s, small_repertoire, task=task)
-    training = calls[:1] + [c for c in calls[1:] if c[0] == 24]
-    assert len(training) == 3 and all(n == 24 for n, _, _ in training)  # every genome
-    for g, (_, starts, names) in enumerate(training):
-        expected, _ = training_task().generation_episodes(np.random.default_rng([3, g]))
-        assert np.array_equal(starts, expected) and names[2:] != calls[0][2][2:] or g == 0
+    # One call per generation with the whole population, then the post-selection's.
+    assert len(calls) == 4 and [n for n, _, _ in calls[:3]] == [24, 24, 24]
+    for g, (_, starts, names) in enumerate(calls[:3]):
+        expected = training_task()
+        rows, _ = expected.generation_episodes(np.random.default_rng([3, g]))
+        assert np.array_equal(starts, rows) and names == [m.name for m in expected.mazes]
+    validation = calls[3][2][2:]
+    assert len(validation) == 2 and not set(validation) & {n for c in calls[:3] for n in c[2]}
 
 
 def _net():
@@ -224,7 +227,7 @@ def test_training_refuses_the_held_out_seed_and_held_out_maze_files(tmp_path):
     save_maze(held, tmp_path / "held.yaml")
     values = {**SMALL_TASK, "mazes": ["obstacle", str(tmp_path / "held.yaml")]}
     paper = MazeTask(MazeTaskSettings.from_dict(values, "t.yaml"), "4ws-5")
-    with pytest.raises(ConfigError, match="t.yaml: mazes: gen21021-004 is a held-out maze"):
+    with pytest.raises(ConfigError, match=r"t\.yaml: mazes: gen21021-004 is a held-out maze"):
         paper.start_training("4ws-5", 1, source="t.yaml")
 
 
@@ -325,5 +328,5 @@ def test_perturbed_training_needs_a_simulation_that_takes_perturbations():
     task = MazeTask(MazeTaskSettings.from_dict(task_dict(perturb="realistic"), "t"), "4ws-5")
     task.start_training("4ws-5", 1, source="t.yaml")  # the kinematic kernel takes them
     task.perturbation_family = None  # as a legged robot's task without perturbed worlds
-    with pytest.raises(ConfigError, match="t.yaml: training: perturb realistic: 4ws-5's"):
+    with pytest.raises(ConfigError, match=r"t\.yaml: training: perturb realistic: 4ws-5's"):
         task.start_training("4ws-5", 1, source="t.yaml")

@@ -1,0 +1,39 @@
+"""Print the table of docs/generalisation.md from the finished runs here (markdown)."""
+
+import json
+import statistics
+from pathlib import Path
+
+HERE = Path(__file__).parent
+
+
+def main() -> None:
+    """Print one row per finished run."""
+    print(
+        "| run | training | paper mazes reached | held-out reached | held-out fitness "
+        "| post-selection reached | s / generation |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    for held in sorted(HERE.glob("*-seed*.held.json")):
+        stem = held.name[: -len(".held.json")]
+        paper = json.loads((HERE / f"{stem}.paper.json").read_text())["overall"]
+        h = json.loads(held.read_text())["overall"]
+        arb = json.loads((HERE / f"{stem}.arbitrator.json").read_text())["evolution"]
+        training = arb["task"].get("training")
+        what = "none (paper protocol)"
+        if training:
+            source = f"pool {training['pool']}" if training["pool"] else "fresh"
+            what = f"K {training['generated']} x S {training['starts']}, {source}"
+            if not training["task_mazes"]:
+                what += ", no paper mazes"
+        seconds = statistics.median(g["seconds"] for g in arb["history"])
+        post = arb["post_evaluation"]
+        print(
+            f"| {stem} | {what} | {paper['reach_rate']:.0%} | **{h['reach_rate']:.1%}** | "
+            f"{h['mean_fitness']:.3f} | {post['reached']:.0%} of {post['episodes_per_candidate']} "
+            f"| {seconds:.2f} |"
+        )
+
+
+if __name__ == "__main__":
+    main()
