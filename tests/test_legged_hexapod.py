@@ -21,15 +21,16 @@ from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.config import config_dir
 from evorbc_ros.defaults import default_arbitrator, default_repertoire
 from evorbc_ros.repertoire import Repertoire
-from evorbc_ros.robots.hexapod import GaitTable, hexapod_gait, mirror_genes
+from evorbc_ros.robots.hexapod import GaitTable, HexapodGeometry, hexapod_gait, mirror_genes
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
-from sim_bridge.hexapod.evaluate import evaluate_genes
-from sim_bridge.hexapod.physics import HexapodSim, hexapod_settings
+from sim_bridge.hexapod.evaluate import HEADING, PATH, TILT, X, Y, evaluate_genes
+from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings, hexapod_settings
 from sim_bridge.hexapod.urdf import hexapod_urdf
 from sim_bridge.legged import episode as legged_episode
 from sim_bridge.legged.physics import LeggedSim
+from sim_bridge.legged.robot import LeggedRobot
 from sim_bridge.legged.settings import load_robot_settings
-from sim_bridge.robots.hexapod import DISCARD_TILT
+from sim_bridge.robots.hexapod import DISCARD_TILT, HexapodRobot, describe_simulation
 
 YAML = config_dir() / "robots" / "hexapod.yaml"
 
@@ -76,6 +77,22 @@ def test_primitive_outcomes_are_bit_identical_through_every_path(from_yaml):
     assert np.any(old[:, 4] > DISCARD_TILT) and np.any(old[:, 4] < DISCARD_TILT)
     np.testing.assert_array_equal(wrapped, old)
     np.testing.assert_array_equal(generic, old)
+
+
+def test_the_hexapod_robot_is_the_settings_files_legged_robot(from_yaml):
+    genes = np.vstack([np.random.default_rng(6).uniform(-1.0, 1.0, (8, 37)), tripod()])
+    with HexapodSim() as sim:
+        want = evaluate_genes(sim, genes, 2.0, 0.1, DISCARD_TILT)
+    robot = HexapodRobot(workers=1)
+    try:
+        assert isinstance(robot, LeggedRobot) and robot.settings == from_yaml
+        assert robot.describe() == describe_simulation(HexapodGeometry(), PhysicsSettings())
+        got = robot.evaluate_primitives(genes, 2.0)
+    finally:
+        robot.close()
+    for name, column in (("x", X), ("y", Y), ("heading", HEADING), ("path", PATH)):
+        np.testing.assert_array_equal(getattr(got, name), want[:, column], err_msg=name)
+    np.testing.assert_array_equal(got.max_tilt, want[:, TILT])
 
 
 @pytest.fixture(scope="module")

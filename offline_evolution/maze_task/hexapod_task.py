@@ -9,12 +9,10 @@ settings. Its files record the hexapod's geometry and physics, as they always di
 
 from __future__ import annotations
 
-from evorbc_ros.config import config_dir
-from evorbc_ros.robots.hexapod import HEXAPOD, HexapodGeometry
+from evorbc_ros.robots.hexapod import HexapodGeometry
 from offline_evolution.maze_task.base import MazeTaskSettings
 from offline_evolution.maze_task.legged_task import LeggedMazeTask
-from sim_bridge.hexapod.physics import PhysicsSettings, hexapod_settings
-from sim_bridge.legged.settings import load_robot_settings
+from sim_bridge.hexapod.physics import PhysicsSettings, hexapod_robot_settings
 from sim_bridge.robots.hexapod import describe_simulation
 
 
@@ -37,10 +35,7 @@ class HexapodMazeTask(LeggedMazeTask):
         geometry: HexapodGeometry | None = None,
         physics: PhysicsSettings | None = None,
     ):
-        if geometry is None and physics is None:
-            robot = load_robot_settings(config_dir() / "robots" / f"{HEXAPOD}.yaml")
-        else:
-            robot = hexapod_settings(geometry, physics)
+        robot = hexapod_robot_settings(geometry, physics)
         self.geometry = geometry or HexapodGeometry()
         self.physics = physics or PhysicsSettings()
         super().__init__(settings, robot, workers)
