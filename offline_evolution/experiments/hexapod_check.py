@@ -23,7 +23,7 @@ def summarise(repertoire: Path, out: Path, seeds: list[int], standard_seeds: lis
 
 def main() -> None:
     """Command-line entry point."""
-    legged_check.main("hexapod")
+    legged_check.main("hexapod", "hexapod_check")
 
 
 if __name__ == "__main__":

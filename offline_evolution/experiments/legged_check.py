@@ -346,8 +346,13 @@ def _evolution(path: Path) -> dict | None:
     return ArbitratorFile.load(path).evolution if path.exists() else None
 
 
-def main(robot: str | None = None) -> None:
-    """Command-line entry point (``robot``: fixed by a robot's own check, else ``--robot``)."""
+def main(robot: str | None = None, name: str = "legged_check") -> None:
+    """Command-line entry point.
+
+    Args:
+        robot: fixed by a robot's own check (``hexapod_check``), else ``--robot``.
+        name: the program's name in error messages.
+    """
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     if robot is None:
         parser.add_argument("--robot", required=True, help="a legged robot of the registry")
@@ -364,7 +369,6 @@ def main(robot: str | None = None) -> None:
     parser.add_argument("--summarise-only", action="store_true")
     args = parser.parse_args()
     robot = robot or args.robot
-    name = "hexapod_check" if robot == "hexapod" else "legged_check"
     try:
         lookup(robot)
         rep = Repertoire.load(args.repertoire)
