@@ -26,11 +26,11 @@ from bench_hexapod_repertoire import machine
 
 from evorbc_ros.network import ConnectionSpec, NetworkSpec, NodeSpec
 from offline_evolution.arbitrator.settings import load_run_settings
-from offline_evolution.maze_task.hexapod_episode import EpisodeRunner, HexapodController
 from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
 from offline_evolution.maze_task.task import MazeTaskSettings
 from sim_bridge.hexapod.evaluate import X, Y, evaluate_genes
 from sim_bridge.hexapod.physics import HexapodSim
+from sim_bridge.legged.episode import EpisodeRunner, LeggedController
 from sim_bridge.robots.hexapod import DISCARD_TILT
 
 N_INPUTS = 6  # five laser groups and the goal bearing (config/sensors/hexapod.yaml)
@@ -48,7 +48,7 @@ def random_network(n_outputs: int, rng: np.random.Generator) -> NetworkSpec:
     return NetworkSpec(inputs, outputs, nodes, connections)
 
 
-def random_controller(n: int, rng: np.random.Generator) -> HexapodController:
+def random_controller(n: int, rng: np.random.Generator) -> LeggedController:
     """EvoRBC with ``n`` random primitives, their behaviours simulated for 2 s from rest."""
     genes = rng.uniform(-1.0, 1.0, size=(n, 37))
     sim = HexapodSim()
@@ -56,7 +56,7 @@ def random_controller(n: int, rng: np.random.Generator) -> HexapodController:
         out = evaluate_genes(sim, genes, 2.0, sim.geometry.control_period, DISCARD_TILT)
     finally:
         sim.close()
-    return HexapodController("evorbc", "polar", genes, out[:, [X, Y]], key="bench")
+    return LeggedController("evorbc", "polar", genes, out[:, [X, Y]], key="bench")
 
 
 def time_episodes(runner, network, controller, starts, repeats: int) -> tuple[float, float]:

@@ -201,7 +201,7 @@ def pipeline(tmp_path_factory):
     for key in ("repertoire", "arbitrator", "task"):
         burger = burger.replace(f"  {key}: ", f"  {key}: {key}.yaml  # ", 1)
     burger = burger.replace("  neat: neat/4ws.ini", "  neat: neat.ini")
-    burger = burger.replace("maze: obstacle", "maze: gaps").replace(
+    burger = burger.replace("maze: zigzag", "maze: gaps").replace(
         "episode_time: 120.0", "episode_time: 15.0"
     )
     write(folder / "burger-test.yaml", burger)

@@ -105,3 +105,25 @@ def test_an_unfinished_standard_run_is_reported_from_its_checkpoint(runs, tmp_pa
     (tmp_path / "standard-seed1.json.checkpoint.json").write_text('{"settings": {}}')
     with pytest.raises(CheckpointError, match="not a NEAT checkpoint with a generation history"):
         summarise(runs / "rep.json", tmp_path, [], [1])
+
+
+def test_another_legged_robot_has_no_paper_column_and_its_own_budget(runs, tmp_path):
+    """The A1's comparison (docs/a1.md): no paper values; the stated extra generations."""
+    from offline_evolution.experiments.legged_check import summarise as legged_summarise
+
+    runs, _ = runs
+    history = [{"best_so_far": 0.01 * g, "best_reached": int(g > 30)} for g in range(40)]
+    ckpt = {"settings": {"generations": 100}, "history": history}
+    (tmp_path / "evorbc-seed1.json.checkpoint.json").write_text(json.dumps(ckpt))
+    ckpt = {"settings": {"generations": 233}, "history": history[:20]}
+    (tmp_path / "standard-seed1.json.checkpoint.json").write_text(json.dumps(ckpt))
+    text = legged_summarise(runs / "rep.json", tmp_path, [1], [1], "a1", standard_extra=133)
+    lines = text.splitlines()
+    assert lines[:2] == ["| figure | here |", "|---|---|"]
+    assert all(line.count(" | ") == 1 for line in lines if line.startswith("| "))
+    evo = next(line for line in lines if line.startswith("| EvoRBC still running"))
+    assert "seed 1: generation 40 of 100, best fitness so far 0.39 (generation 40)" in evo
+    assert "goal reached" in evo
+    std = next(line for line in lines if line.startswith("| standard NEAT still running"))
+    assert "generation 20 of 233" in std and "EvoRBC's budget" not in std  # 100 not yet run
+    assert (tmp_path / "a1-check.md").read_text() == text

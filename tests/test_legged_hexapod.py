@@ -1,9 +1,12 @@
 """The hexapod is an instance of the generic legged robot, and its results are unchanged.
 
-Three paths give every number: the code that simulated the hexapod before the generic
-legged robot existed (``reference_hexapod.py``), the hexapod's own modules (now thin
-wrappers over ``sim_bridge/legged``) and the generic legged robot built from
-``config/robots/hexapod.yaml``. Primitive outcomes and maze episodes agree bit for bit.
+Three paths give every primitive outcome: the code that simulated the hexapod before the
+generic legged robot existed (``reference_hexapod.py``), the hexapod's own modules (now
+thin wrappers over ``sim_bridge/legged``) and the generic legged robot built from
+``config/robots/hexapod.yaml``; they agree bit for bit. The hexapod's maze episodes run on
+the legged robots' one episode runner (``sim_bridge/legged/episode.py``); they equal the
+episodes on the old simulation and gait, and, perturbed or not, the digests the hexapod's
+own runner gave before the two runners became one (``hexapod_pins.py``).
 """
 
 import dataclasses
@@ -12,21 +15,22 @@ import numpy as np
 import pytest
 import reference_hexapod as reference
 from hexapod_helpers import tripod
+from hexapod_pins import cases, digest
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.config import config_dir
 from evorbc_ros.defaults import default_arbitrator, default_repertoire
 from evorbc_ros.repertoire import Repertoire
-from evorbc_ros.robots.hexapod import GaitTable, hexapod_gait, mirror_genes
-from offline_evolution.maze_task import hexapod_episode
+from evorbc_ros.robots.hexapod import GaitTable, HexapodGeometry, hexapod_gait, mirror_genes
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
-from sim_bridge.hexapod.evaluate import evaluate_genes
-from sim_bridge.hexapod.physics import HexapodSim, hexapod_settings
+from sim_bridge.hexapod.evaluate import HEADING, PATH, TILT, X, Y, evaluate_genes
+from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings, hexapod_settings
 from sim_bridge.hexapod.urdf import hexapod_urdf
 from sim_bridge.legged import episode as legged_episode
 from sim_bridge.legged.physics import LeggedSim
+from sim_bridge.legged.robot import LeggedRobot
 from sim_bridge.legged.settings import load_robot_settings
-from sim_bridge.robots.hexapod import DISCARD_TILT
+from sim_bridge.robots.hexapod import DISCARD_TILT, HexapodRobot, describe_simulation
 
 YAML = config_dir() / "robots" / "hexapod.yaml"
 
@@ -75,6 +79,22 @@ def test_primitive_outcomes_are_bit_identical_through_every_path(from_yaml):
     np.testing.assert_array_equal(generic, old)
 
 
+def test_the_hexapod_robot_is_the_settings_files_legged_robot(from_yaml):
+    genes = np.vstack([np.random.default_rng(6).uniform(-1.0, 1.0, (8, 37)), tripod()])
+    with HexapodSim() as sim:
+        want = evaluate_genes(sim, genes, 2.0, 0.1, DISCARD_TILT)
+    robot = HexapodRobot(workers=1)
+    try:
+        assert isinstance(robot, LeggedRobot) and robot.settings == from_yaml
+        assert robot.describe() == describe_simulation(HexapodGeometry(), PhysicsSettings())
+        got = robot.evaluate_primitives(genes, 2.0)
+    finally:
+        robot.close()
+    for name, column in (("x", X), ("y", Y), ("heading", HEADING), ("path", PATH)):
+        np.testing.assert_array_equal(getattr(got, name), want[:, column], err_msg=name)
+    np.testing.assert_array_equal(got.max_tilt, want[:, TILT])
+
+
 @pytest.fixture(scope="module")
 def shipped():
     arb = ArbitratorFile.load(default_arbitrator("hexapod"))
@@ -86,34 +106,67 @@ def shipped():
     return arb.network, controller, world, start
 
 
-def test_the_shipped_controllers_episode_is_bit_identical_through_every_path(
-    shipped, from_yaml, monkeypatch
-):
+def test_the_hexapods_task_runs_the_settings_files_robot(shipped, from_yaml):
+    _, controller, world, _ = shipped
+    assert isinstance(controller, legged_episode.LeggedController)
+    assert world.settings == from_yaml
+
+
+def test_the_shipped_controllers_episode_equals_the_old_simulations(shipped, monkeypatch):
     network, controller, world, start = shipped
-    runner = hexapod_episode.EpisodeRunner(world)
+    runner = legged_episode.EpisodeRunner(world)
     try:
-        wrapped = runner.run(network, controller, 0, start, record=True)
+        new = runner.run(network, controller, 0, start, record=True)
     finally:
         runner.close()
-    generic_world = legged_episode.LeggedWorld(world.mazes, world.layout, from_yaml, world.n_cycles)
-    generic_controller = legged_episode.LeggedController(
-        "evorbc", controller.mapping, controller.genes, controller.behaviour, controller.key
+    # The same episode on the code that simulated the hexapod before: its simulation and
+    # gait in place of the legged robot's.
+    monkeypatch.setattr(
+        legged_episode, "LeggedSim", lambda settings, walls: reference.HexapodSim(walls=walls)
     )
-    runner = legged_episode.EpisodeRunner(generic_world)
-    try:
-        generic = runner.run(network, generic_controller, 0, start, record=True)
-    finally:
-        runner.close()
-    # Today's code: the hexapod episode on the old simulation and gait.
-    monkeypatch.setattr(hexapod_episode, "HexapodSim", reference.HexapodSim)
-    monkeypatch.setattr(hexapod_episode, "GaitTable", reference.GaitTable)
-    runner = hexapod_episode.EpisodeRunner(world)
+    monkeypatch.setattr(
+        legged_episode, "LeggedGaitTable", lambda genes, gait, name: reference.GaitTable(genes)
+    )
+    runner = legged_episode.EpisodeRunner(world)
     try:
         old = runner.run(network, controller, 0, start, record=True)
     finally:
         runner.close()
     assert old["reached"] and len(old["choice"]) > 200
-    for result in (wrapped, generic):
-        assert result.keys() == old.keys()
-        for key, value in old.items():
-            np.testing.assert_array_equal(result[key], value, err_msg=key)
+    assert new.keys() == old.keys()
+    for key, value in old.items():
+        np.testing.assert_array_equal(new[key], value, err_msg=key)
+
+
+#: :func:`hexapod_pins.digest` of each case of :func:`hexapod_pins.cases` on the hexapod's
+#: own episode runner (``offline_evolution/maze_task/hexapod_episode.py``, commit 9ef42ce),
+#: with cycles and final distances (m, float.hex) for a readable failure.
+PINS = {
+    "shipped": (
+        "9862a5514b022dd674ab618b1d002b6a8cfed2067d2843420e296cd7c4512d3c",
+        [288],
+        ["0x1.f020dceea7a7cp-3"],
+    ),
+    "shipped-realistic": (
+        "baea1894b651f9c3d37bf436e252d641d0a52c277444545eb27422ddc2c73f52",
+        [300, 300, 300],
+        ["0x1.047b680d5b643p+1", "0x1.12fc69f61af27p+2", "0x1.fa8dcba3c2fbap+0"],
+    ),
+    "standard-harsh": (
+        "ee6f38ffe3f166afe34c17a0021010ced7964c1d872903d93252edde882678a0",
+        [40, 40],
+        ["0x1.bef8ce4c3fe18p+2", "0x1.bcc10975a4e24p+2"],
+    ),
+}
+
+
+def test_perturbed_and_nominal_episodes_equal_the_hexapods_old_runners():
+    got = cases()
+    assert got.keys() == PINS.keys()
+    _, world = got["shipped-realistic"]
+    assert world.values["latency_cycles"].tolist() == [0.0, 1.0, 0.0]
+    for name, (result, _) in got.items():
+        pin, cycles, final = PINS[name]
+        assert result.cycles.tolist() == cycles, name
+        assert [float(d).hex() for d in result.final_distance] == final, name
+        assert digest(result) == pin, name

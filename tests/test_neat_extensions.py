@@ -6,7 +6,8 @@ import neat
 import pytest
 from neat_helpers import neat_config, random_genomes
 
-from offline_evolution.arbitrator.neat_classes import TargetSpeciesSet
+from offline_evolution.arbitrator.neat_classes import TargetSpeciesSet, exact_spawn
+from offline_evolution.arbitrator.neat_config import load_neat_config
 
 
 def child_of(config, p1, p2, probability, seed):
@@ -85,3 +86,36 @@ def test_evolution_keeps_the_species_count_near_the_target():
         pop.run(fitness, 1)
         counts.append(len(pop.species.species))
     assert 3 <= sum(counts[-15:]) / 15 <= 8
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_population_of_16_evolves_to_the_end(seed):
+    """neat-python stopped such runs with a RuntimeError (too many species for 16 genomes,
+    or spawn counts its single pass could not fix); species are now capped and merged."""
+    config = load_neat_config("config/neat/4ws.ini", 10, 2)
+    config.pop_size = 16
+    pop = neat.Population(config, seed=seed)
+    rng = random.Random(seed)
+
+    def fitness(genomes, config):  # noisy, so species keep appearing and stagnating
+        for _, g in genomes:
+            g.fitness = sum(c.weight for c in g.connections.values()) + rng.random()
+
+    cap = 16 // max(config.reproduction_config.min_species_size, config.reproduction_config.elitism)
+    for _ in range(300):
+        pop.run(fitness, 1)
+        assert len(pop.species.species) <= cap
+        assert len(pop.population) == 16
+
+
+@pytest.mark.parametrize(
+    ("spawn", "pop", "minimum", "expected"),
+    [
+        ([9, 9, 2, 2], 16, 2, [6, 6, 2, 2]),  # 6 too many: more than one pass over species
+        ([1, 1, 1], 9, 2, [3, 3, 3]),  # below the minimum, then short
+        ([4, 4], 8, 2, [4, 4]),
+    ],
+)
+def test_exact_spawn_meets_the_population_size_and_the_minimum(spawn, pop, minimum, expected):
+    out = exact_spawn(spawn, pop, minimum)
+    assert out == expected and sum(out) == pop and min(out) >= minimum

@@ -45,7 +45,7 @@ def test_the_builtin_robots_are_each_declared_once_and_completely():
         "a1": 455,
         "turtlebot3-burger": 25,
     }
-    assert [r.name for r in registry.robots() if r.shipped_arbitrator] == ["4ws-5", "hexapod"]
+    assert [r.name for r in registry.robots() if r.shipped_arbitrator] == ["4ws-5", "hexapod", "a1"]
 
 
 def test_a_4ws_registration_matches_its_simulated_robot():

@@ -74,8 +74,10 @@ def test_evorbc_sim_runs_the_a1(tmp_path, controller, capsys):
     result = tmp_path / "run.json"
     # Started a few cm from the target: the episode ends at the first cycle, reached.
     argv = ["--robot", "a1", "--arbitrator", str(arb_path), "--repertoire", str(rep_path)]
-    argv += ["--start=3.3,-0.45,0", "--result", str(result), "--plot", "", "--quiet"]
+    picture = tmp_path / "run.png"  # not <maze>-run.png in the working directory
+    argv += ["--start=3.3,-0.45,0", "--result", str(result), "--plot", str(picture), "--quiet"]
     assert main([*argv, "--domain-id", "172"]) == 0
+    assert picture.is_file()
     got = json.loads(result.read_text())
     assert got["robot"] == "a1" and got["maze"] == "a1" and got["reached"]
     assert got["episode_time"] == 30.0

@@ -8,7 +8,9 @@ before plugins (docs/design.md section 19, docs/your-robot.md). A YAML file ther
 robots' URDF settings) and is left alone.
 
 Kinds (:data:`KINDS`): ``four_ws``, one of the paper's 4WS gene layouts on a body of the
-file's dimensions, and ``diff_drive``, a differential-drive robot. Keys every kind takes:
+file's dimensions; ``diff_drive``, a differential-drive robot; and ``legged``, a legged
+robot from its URDF, whose ``model`` key names its legged settings file (docs/legged.md:
+URDF, joints, gait, servos, physics). Keys every kind takes:
 
 * ``kind``, ``name`` (default: the file's stem), ``description``;
 * ``settings``: ``repertoire``, ``arbitrator``, ``neat``, ``task`` files, and ``sensors``,
@@ -17,7 +19,7 @@ file's dimensions, and ``diff_drive``, a differential-drive robot. Keys every ki
 * ``geometry``: the kind's body and limits (:class:`~evorbc_ros.robots.four_ws.FourWSGeometry`
   keys for ``four_ws``, which keep the paper's value for a key not given;
   :class:`~evorbc_ros.robots.diff_drive.DiffDriveGeometry` keys, all required, for
-  ``diff_drive``).
+  ``diff_drive``; none for ``legged``, whose body is its ``model``).
 
 This module depends on numpy and PyYAML only (docs/design.md section 17).
 """
@@ -36,7 +38,7 @@ from evorbc_ros.robots.registry import Robot, SettingsFiles
 #: The environment variable naming the user's folders of robot settings files.
 PATH_VARIABLE = "EVORBC_ROBOT_PATH"
 #: The kinds a robot settings file may declare.
-KINDS = ("four_ws", "diff_drive")
+KINDS = ("four_ws", "diff_drive", "legged")
 
 
 @dataclass(frozen=True)
@@ -47,6 +49,7 @@ class RobotFileKeys:
     name: str | None = setting(None, doc="the robot's name (default: the file's stem)")
     description: str = setting("", doc="one line for listings")
     type: str | None = setting(None, doc="four_ws: the paper's gene layout it uses")
+    model: str | None = setting(None, doc="legged: its legged settings file (docs/legged.md)")
     # Mappings, checked by the kind (geometry) and by _SettingsKeys (settings).
     geometry: Any = None
     settings: Any = None
@@ -122,7 +125,11 @@ def read_robot_file(path: str | os.PathLike) -> Robot | None:
         )
     files = build_settings(_SettingsKeys, files, f"{source}: settings")
     folder = path.resolve().parent
-    builder = {"four_ws": _four_ws, "diff_drive": _diff_drive}[keys.kind]
+    if keys.model is not None:
+        if keys.kind != "legged":
+            raise ConfigError(f"{source}: model is for legged robots; remove it")
+        keys = dataclasses.replace(keys, model=_resolve(keys.model, folder))
+    builder = {"four_ws": _four_ws, "diff_drive": _diff_drive, "legged": _legged}[keys.kind]
     robot = builder(keys, geometry, source)
     given = {
         f.name: _resolve(getattr(files, f.name), folder)
@@ -192,3 +199,28 @@ def _diff_drive(keys: RobotFileKeys, geometry: dict, source: str) -> Robot:
         raise ConfigError(f"{source}: type is for four_ws robots; remove it")
     body = DiffDriveGeometry.from_mapping(geometry, f"{source}: geometry")
     return diff_drive_robot(keys.name or Path(source).stem, body)
+
+
+def _legged(keys: RobotFileKeys, geometry: dict, source: str) -> Robot:
+    """A legged robot: the generic legged registration of its ``model`` settings file."""
+    from evorbc_ros.robots.builtin.legged import legged_robot
+
+    if keys.type is not None or geometry:
+        raise ConfigError(
+            f"{source}: type and geometry are not for legged robots; their body is the "
+            "model settings file"
+        )
+    if keys.model is None:
+        raise ConfigError(f"{source}: model: expected the legged settings file (docs/legged.md)")
+    model = Path(keys.model) if Path(keys.model).is_absolute() else config_dir() / keys.model
+    if not model.is_file():
+        raise ConfigError(f"{source}: model: no such file {keys.model}")
+    robot = legged_robot(str(model), "legged robot from its URDF")
+    name = keys.name or Path(source).stem
+    if robot.name != name:
+        # The model's name is what its repertoire and arbitrator files record.
+        raise ConfigError(
+            f"{source}: the robot is named {name!r} but its model {keys.model} names "
+            f"{robot.name!r}; give both the same name"
+        )
+    return robot

@@ -14,7 +14,11 @@ import neat
 from evorbc_ros.config import INT_LIMIT, ConfigError
 from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular_text
 from evorbc_ros.network import ACTIVATIONS, AGGREGATIONS
-from offline_evolution.arbitrator.neat_classes import EvoRBCGenome, TargetSpeciesSet
+from offline_evolution.arbitrator.neat_classes import (
+    EvoRBCGenome,
+    EvoRBCReproduction,
+    TargetSpeciesSet,
+)
 
 GENOME_SECTION = EvoRBCGenome.__name__
 #: neat-python's ways of connecting a new genome (first word; "partial" takes a fraction).
@@ -57,6 +61,9 @@ def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int)
     _check_limits(parser[GENOME_SECTION], source)
     parser[GENOME_SECTION]["num_inputs"] = str(num_inputs)
     parser[GENOME_SECTION]["num_outputs"] = str(num_outputs)
+    # Users write neat-python's section name; the class that reads it is evorbc's.
+    if parser.has_section("DefaultReproduction"):
+        parser["EvoRBCReproduction"] = dict(parser["DefaultReproduction"])
     buf = io.StringIO()
     parser.write(buf)
     # neat-python reads settings only from a file name.
@@ -65,7 +72,7 @@ def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int)
         with os.fdopen(fd, "w") as f:
             f.write(buf.getvalue())
         config = neat.Config(
-            EvoRBCGenome, neat.DefaultReproduction, TargetSpeciesSet, neat.DefaultStagnation, tmp
+            EvoRBCGenome, EvoRBCReproduction, TargetSpeciesSet, neat.DefaultStagnation, tmp
         )
     except AssertionError:  # neat-python asserts on an unknown initial_connection
         raise ConfigError(

@@ -1,20 +1,28 @@
 """The maze task for any legged robot from a URDF plus a settings file (parent side).
 
-The hexapod's task (:class:`~offline_evolution.maze_task.hexapod_task.HexapodMazeTask`:
-settings, mazes, starts, eq. 5 fitness, episodes spread over spawned PyBullet workers) with
-the legged robot's episode (:mod:`sim_bridge.legged.episode`) for the robot its settings
-file describes (``config/robots/*.yaml``, docs/legged.md). Episodes are independent and
-start from a restored rest state, so results do not depend on the number of workers.
+Settings, mazes, start poses and eq. 5 fitness are every maze task's
+(:class:`~offline_evolution.maze_task.base.MazeTaskBase`); this module adds episodes in
+PyBullet on worker processes (:mod:`sim_bridge.legged.episode`) for the robot its settings
+file describes (``config/robots/*.yaml``, docs/legged.md), in perturbed worlds too
+(docs/design.md section 21), and implements the task protocol
+(:class:`~offline_evolution.task_protocol.ArbitratorTask`). The hexapod's task
+(:mod:`~offline_evolution.maze_task.hexapod_task`) is this one with the hexapod. Episodes
+are independent and start from a restored rest state, so results do not depend on the
+number of workers or on which worker ran an episode.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
 from evorbc_ros.config import ConfigError
+from evorbc_ros.network import NetworkSpec
+from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.primitive import ParameterSpec
-from offline_evolution.maze_task.base import MazeTaskBase, MazeTaskSettings
-from offline_evolution.maze_task.hexapod_task import HexapodMazeTask, _run
+from offline_evolution.maze_task.base import MazeTaskBase, MazeTaskSettings, empty_traces
+from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.legged.episode import EpisodeRunner, LeggedController, LeggedWorld
-from sim_bridge.legged.pool import available_cores, ignore_sigint
+from sim_bridge.legged.pool import SpawnedWorkers, available_cores, ignore_sigint
 from sim_bridge.legged.scanner import Scanner
 from sim_bridge.legged.settings import LeggedRobotSettings, load_robot_settings
 
@@ -27,11 +35,16 @@ def _init_worker(world: LeggedWorld) -> None:
     _runner = EpisodeRunner(world)
 
 
+def _run(runner: EpisodeRunner, job) -> dict:
+    network, controller, maze, start, record, world = job
+    return runner.run(NetworkSpec.from_dict(network), controller, maze, start, record, world)
+
+
 def _episode(job) -> dict:
     return _run(_runner, job)
 
 
-class LeggedMazeTask(HexapodMazeTask):
+class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
     """The maze task of the legged robot ``robot`` describes (its ``settings`` file).
 
     Args:
@@ -39,7 +52,15 @@ class LeggedMazeTask(HexapodMazeTask):
         robot: the legged robot, or the path of its settings file.
         workers: PyBullet worker processes (default: every core).
 
+    Raises:
+        ConfigError: naming the file: the robot's settings, or a sensor layout without
+            rangefinders or whose rays no LaserScan can hold.
+
     """
+
+    #: Its simulation's kind, for what a perturbation set can change (docs/design.md
+    #: section 21).
+    perturbation_family = "pybullet-legged"
 
     def __init__(
         self,
@@ -52,15 +73,16 @@ class LeggedMazeTask(HexapodMazeTask):
         self.robot = robot
         if robot.footprint_radius is None:
             raise ConfigError(f"{robot.source}: footprint_radius: needed for the maze task")
-        MazeTaskBase.__init__(self, settings, robot.control_period, robot.footprint_radius)
+        super().__init__(settings, robot.control_period, robot.footprint_radius)
         if self.layout.rangefinders is None:
-            raise ConfigError(f"{settings.sensors}: a legged robot's laser needs rangefinders")
+            raise ConfigError(f"{settings.sensors}: the {robot.name}'s laser needs rangefinders")
         try:  # here, not first in a worker, so that the error names the file
             Scanner.from_layout(self.layout.rangefinders)
         except ValueError as e:
             raise ConfigError(f"{settings.sensors}: {e}") from None
         self.world = LeggedWorld(tuple(self.mazes), self.layout, robot, self.n_cycles)
         self.workers = max(1, workers or available_cores())
+        self.cluster_workers = workers
 
     def describe(self) -> dict:
         """The simulated robot, as repertoire files record it."""
@@ -71,12 +93,78 @@ class LeggedMazeTask(HexapodMazeTask):
         """The robot's locomotion parameters (a standard controller's outputs)."""
         return self.robot.gait.parameter_specs()
 
-    #: No perturbed worlds yet (the hexapod's episode applies them; this one does not).
-    perturbation_family = None
-    controller_type = LeggedController
-    runner_type = EpisodeRunner
-    worker_init = staticmethod(_init_worker)
-    worker_episode = staticmethod(_episode)
+    def controller(
+        self, kind: str, repertoire: Repertoire | None = None, mapping: str | None = None
+    ) -> LeggedController:
+        """An EvoRBC controller (repertoire and mapping) or a standard one."""
+        if kind == "evorbc":
+            key = f"evorbc:{mapping}:{repertoire.fingerprint()}"
+            return LeggedController("evorbc", mapping, repertoire.genes, repertoire.behaviour, key)
+        return LeggedController("standard", key="standard")
+
+    def evaluate(
+        self,
+        networks: list[NetworkSpec],
+        controller: LeggedController,
+        starts: np.ndarray,
+        record: bool = False,
+        world=None,
+    ) -> EpisodeResult:
+        """Every network from every start row; episode ``i * len(starts) + j``.
+
+        ``world``: a :class:`~offline_evolution.maze_task.perturbation.WorldDraw` with one
+        row per start (its start errors already applied to ``starts``), or None.
+        """
+        rows = [world.row(k) if world is not None else None for k in range(len(starts))]
+        jobs = [
+            (
+                net.to_dict(),
+                controller,
+                self._job_maze(row[0]),
+                tuple(map(float, row[1:4])),
+                record,
+                w,
+            )
+            for net in networks
+            for row, w in zip(starts, rows, strict=True)
+        ]
+        results = self._map(jobs)
+        reached = np.array([r["reached"] for r in results], dtype=bool)
+        cycles = np.array([r["cycles"] for r in results], dtype=np.int64)
+        final = np.array([r["final_distance"] for r in results])
+        initial = np.array([r["initial_distance"] for r in results])
+        fell = np.array([r["fell"] for r in results], dtype=bool)
+        traces = _padded_traces(results, self.n_cycles) if record else None
+        return self.episode_result(reached, cycles, final, initial, traces, fell)
+
+    def _job_maze(self, column: float):
+        """How a job names maze ``column``: by index or, if generated, the maze itself.
+
+        The workers hold the task's own mazes; generated ones are new every generation
+        (docs/design.md section 22), so their jobs carry them.
+        """
+        k = int(column)
+        return k if k < len(self.task_mazes) else self.mazes[k]
+
+    def _map(self, jobs: list) -> list[dict]:
+        if self.in_process() or len(jobs) == 1:
+            if self._local is None:
+                self._local = EpisodeRunner(self.world)
+            return [_run(self._local, job) for job in jobs]
+        return list(self._pool(_init_worker, (self.world,)).map(_episode, jobs))
+
+
+def _padded_traces(results: list[dict], n_cycles: int):
+    """Per-episode traces padded like the 4WS kernel's (:func:`empty_traces`)."""
+    n_out = max((r["outputs"].shape[1] for r in results if r["outputs"].size), default=1)
+    pose, choice, outputs = empty_traces(len(results), n_cycles, n_out)
+    for e, r in enumerate(results):
+        k = len(r["choice"])
+        pose[e, : k + 1] = r["pose"]
+        choice[e, :k] = r["choice"]
+        if k:
+            outputs[e, :k] = r["outputs"]
+    return pose, choice, outputs
 
 
 def legged_task(robot, settings: MazeTaskSettings, workers: int | None = None) -> LeggedMazeTask:

@@ -8,8 +8,10 @@ and a maze task applies those its simulation has (:data:`APPLIES`):
 * the 4WS robots' kinematic model (``sim_bridge/four_ws_motion.py``) has no friction, mass
   or servos; it takes the wheel speed gain, the latency, the rangefinder noise and
   dropouts and the start pose, inside the compiled kernel;
-* the hexapod (PyBullet) takes ground friction, body mass and payload, servo strength and
-  speed, the latency, the laser's noise and dropouts and the start pose.
+* the legged robots (PyBullet: the hexapod, the A1, any from a settings file,
+  :mod:`sim_bridge.legged.perturbed`) take ground friction, body (root link) mass and
+  payload, servo strength and speed, the latency, the laser's noise and dropouts and the
+  start pose.
 
 The all-zero set (every factor 1, every noise 0) changes nothing, bit for bit; so the same
 code runs with and without perturbations. Each start row gets its own noise key, so an

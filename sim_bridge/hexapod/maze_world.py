@@ -1,8 +1,8 @@
 """The hexapod in a maze for the simulation bridge: the legged robot's maze world.
 
-:class:`~sim_bridge.legged.maze_world.LeggedMazeWorld` with the hexapod's simulation and
-laser; offline evolution runs the same episodes
-(:mod:`offline_evolution.maze_task.hexapod_episode`).
+:class:`~sim_bridge.legged.maze_world.LeggedMazeWorld` with the hexapod's simulation
+(:func:`~sim_bridge.hexapod.physics.hexapod_robot_settings`) and laser; offline evolution
+runs the same episodes (:mod:`sim_bridge.legged.episode`).
 """
 
 from __future__ import annotations
@@ -10,8 +10,9 @@ from __future__ import annotations
 import math
 
 from evorbc_ros.robots.hexapod import HexapodGeometry
-from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings
+from sim_bridge.hexapod.physics import PhysicsSettings, hexapod_robot_settings
 from sim_bridge.legged.maze_world import LeggedMazeWorld
+from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.maze import Maze
 
 #: Body tilt (rad) at which the hexapod has fallen over: the episode ends there.
@@ -35,8 +36,9 @@ class HexapodMazeWorld(LeggedMazeWorld):
         sensors: str = DEFAULT_SENSORS,
     ) -> None:
         self.geometry = geometry or HexapodGeometry()
+        settings = hexapod_robot_settings(geometry, physics)
 
         def sim(walls, gui):
-            return HexapodSim(self.geometry, physics or PhysicsSettings(), walls, gui=gui)
+            return LeggedSim(settings, walls, gui=gui)
 
         super().__init__(maze, sim, sensors, start, episode_time, gui)

@@ -15,6 +15,7 @@ import functools
 
 import numpy as np
 
+from evorbc_ros.config import config_dir
 from evorbc_ros.robots.hexapod import HEXAPOD, HexapodGeometry, hexapod_gait
 from sim_bridge.hexapod.urdf import hexapod_urdf
 
@@ -27,7 +28,12 @@ from sim_bridge.legged.physics import (  # noqa: F401
     _tilt,
     _yaw,
 )
-from sim_bridge.legged.settings import LeggedRobotSettings, PhysicsSettings, ServoModel
+from sim_bridge.legged.settings import (
+    LeggedRobotSettings,
+    PhysicsSettings,
+    ServoModel,
+    load_robot_settings,
+)
 
 
 @functools.lru_cache(maxsize=8)
@@ -49,6 +55,21 @@ def hexapod_settings(
         footprint_radius=g.footprint_radius,
         self_collision=True,
     )
+
+
+def hexapod_robot_settings(
+    geometry: HexapodGeometry | None = None, physics: PhysicsSettings | None = None
+) -> LeggedRobotSettings:
+    """The hexapod the search and the maze task simulate.
+
+    The default design is the robot of ``config/robots/hexapod.yaml`` (and
+    ``hexapod.urdf``), as for any legged robot; another design (``geometry`` or
+    ``physics`` given) is built in code (:func:`hexapod_settings`). A test keeps the two
+    bit-identical for the default design.
+    """
+    if geometry is None and physics is None:
+        return load_robot_settings(config_dir() / "robots" / f"{HEXAPOD}.yaml")
+    return hexapod_settings(geometry, physics)
 
 
 class HexapodSim(LeggedSim):

@@ -16,13 +16,20 @@ the joints' start positions before any primitive. The gait clock starts with the
 primitive, as the executor's does.
 
 The ROS graph computes the same numbers from the same messages, so a lockstep run
-reproduces an episode cycle by cycle. This is the hexapod's episode
-(:mod:`offline_evolution.maze_task.hexapod_episode`) for any legged robot; a test keeps
-the two bit-identical on the hexapod.
+reproduces an episode cycle by cycle. Every legged robot runs here, the hexapod
+(``config/robots/hexapod.yaml``) as the A1; tests pin the hexapod's episodes to those of
+the code it had before (``tests/test_legged_hexapod.py``).
+
+A perturbed world (docs/design.md section 21, :mod:`sim_bridge.legged.perturbed`) changes
+the ground's friction, the body's mass (and a payload at its centre), the servos' torque
+and speed for one episode and puts them back after it; delays primitives by whole cycles;
+and adds noise to the laser's beams and loses some (seeded by the episode's key). Nothing
+is changed for identity values.
 """
 
 from __future__ import annotations
 
+import collections
 import math
 from dataclasses import dataclass
 
@@ -34,6 +41,7 @@ from evorbc_ros.mapping import NO_PRIMITIVE, MappingFunction, PrimitiveLookup, c
 from evorbc_ros.network import NetworkSpec
 from evorbc_ros.robots.legged import LeggedGaitTable, gait_step_times
 from evorbc_ros.sensors import SensorLayout
+from sim_bridge.legged.perturbed import perturbed_ranges, perturbed_sim
 from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.legged.scanner import Scanner
 from sim_bridge.legged.settings import LeggedRobotSettings
@@ -121,15 +129,23 @@ class EpisodeRunner:
         """The simulation of task maze ``maze`` or of a generated maze (built on first use)."""
         return self.sims.get(maze)[1]
 
-    def inputs(self, sim: LeggedSim, maze: Maze, base: tuple | None = None) -> np.ndarray:
+    def inputs(
+        self,
+        sim: LeggedSim,
+        maze: Maze,
+        base: tuple | None = None,
+        world: dict | None = None,
+        cycle: int = 0,
+    ) -> np.ndarray:
         """The arbitrator's inputs now: laser groups, then goal bearing.
 
         ``base``: the body's :meth:`~LeggedSim.base_pose` read since the last step, or
-        None to read it now.
+        None to read it now. ``world``, ``cycle``: a perturbed world's row and the cycle
+        (laser noise and dropouts, :func:`~sim_bridge.legged.perturbed.perturbed_ranges`).
         """
         base = sim.base_pose() if base is None else base
         s = self.scanner
-        ranges = s.scan(sim, base)
+        ranges = perturbed_ranges(s.scan(sim, base), world, cycle)
         rf = self.laser.readings(s.angle_min, s.angle_increment, ranges, s.range_min, s.range_max)
         (x, y, _), orn = base
         yaw = yaw_from_quaternion(*orn)
@@ -147,8 +163,8 @@ class EpisodeRunner:
     ) -> dict:
         """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index`` (or a Maze).
 
-        ``world`` must be None: perturbed worlds are the hexapod's so far (its maze task's
-        ``perturbation_family``); the argument keeps the tasks' job tuples one shape.
+        ``world``: a perturbed world's row
+        (:meth:`~offline_evolution.maze_task.perturbation.WorldDraw.row`), or None.
 
         Returns:
             ``{"reached", "fell", "cycles", "final_distance", "initial_distance"}`` and,
@@ -156,8 +172,6 @@ class EpisodeRunner:
             ``"outputs" (cycles, n_outputs)``.
 
         """
-        if world is not None:
-            raise ValueError("this legged robot's episodes take no perturbed world")
         maze, sim = self.sims.get(maze_index)  # a task maze's index or a generated maze
         sim.reset(*start)
         net = network.compile()
@@ -176,35 +190,40 @@ class EpisodeRunner:
         # primitive), the last gait run and the target held while none runs (rad).
         gait_start, last, last_row = None, None, None
         held = sim.joint_states()[0]  # before any primitive: where the joints stand
-        for cycle in range(self.world.n_cycles):
-            out = net.activate(self.inputs(sim, maze, base))
-            index, table, row = chooser.choose(out)
-            if table is not None:
-                if gait_start is None:
-                    gait_start = sim.steps_done
-                last, last_row = table, row
-                times = gait_step_times(sim.steps_done - gait_start, self.per_period, self.dt)
-                targets = table.joint_targets(times, np.repeat(row, len(times)))
-                held = None
-            else:
-                if held is None:  # the last gait's target at this cycle's first step
-                    now = gait_step_times(sim.steps_done - gait_start, 1, self.dt)
-                    held = last.joint_targets(now, last_row)[0]
-                targets = np.repeat(held[None, :], self.per_period, axis=0)
-            tilt, _ = sim.run(targets, max_tilt=self.fallen_tilt)
-            base = sim.base_pose()
-            x, y, heading, _ = sim.pose(base)
-            distance = math.hypot(x - tx, y - ty)
-            if record:
-                poses.append((x, y, heading))
-                choices.append(index)
-                outputs.append(out)
-            if distance <= maze.target_radius:
-                reached, cycles = True, cycle + 1
-                break
-            if tilt > self.fallen_tilt:
-                fell = True  # cycles stays n_cycles: eq. 5 scores where it lies
-                break
+        latency = int(world["latency_cycles"]) if world else 0
+        queue = collections.deque([(NO_PRIMITIVE, None, np.array([0]))] * latency)
+        with perturbed_sim(sim, world):
+            for cycle in range(self.world.n_cycles):
+                out = net.activate(self.inputs(sim, maze, base, world, cycle))
+                # Latency: the choice made ``latency`` cycles ago acts now (none before).
+                queue.append(chooser.choose(out))
+                index, table, row = queue.popleft()
+                if table is not None:
+                    if gait_start is None:
+                        gait_start = sim.steps_done
+                    last, last_row = table, row
+                    times = gait_step_times(sim.steps_done - gait_start, self.per_period, self.dt)
+                    targets = table.joint_targets(times, np.repeat(row, len(times)))
+                    held = None
+                else:
+                    if held is None:  # the last gait's target at this cycle's first step
+                        now = gait_step_times(sim.steps_done - gait_start, 1, self.dt)
+                        held = last.joint_targets(now, last_row)[0]
+                    targets = np.repeat(held[None, :], self.per_period, axis=0)
+                tilt, _ = sim.run(targets, max_tilt=self.fallen_tilt)
+                base = sim.base_pose()
+                x, y, heading, _ = sim.pose(base)
+                distance = math.hypot(x - tx, y - ty)
+                if record:
+                    poses.append((x, y, heading))
+                    choices.append(index)
+                    outputs.append(out)
+                if distance <= maze.target_radius:
+                    reached, cycles = True, cycle + 1
+                    break
+                if tilt > self.fallen_tilt:
+                    fell = True  # cycles stays n_cycles: eq. 5 scores where it lies
+                    break
         result = {
             "reached": reached,
             "fell": fell,

@@ -1,8 +1,7 @@
 """A legged robot in a maze for the simulation bridge: stepped by joint-target trajectories.
 
 The same simulation, scanner and episode rules as offline evolution
-(:mod:`sim_bridge.legged.episode`, and the hexapod's
-:mod:`offline_evolution.maze_task.hexapod_episode`): the bridge publishes what this world
+(:mod:`sim_bridge.legged.episode`): the bridge publishes what this world
 reads, the graph answers with one control period of joint targets, and :meth:`step` runs
 the physics through them. With the same start pose, a lockstep run reproduces the offline
 episode cycle by cycle.

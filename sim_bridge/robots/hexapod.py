@@ -7,18 +7,9 @@ import json
 
 import numpy as np
 
-from evorbc_ros.robots.hexapod import (
-    HEXAPOD,
-    N_PARAMETERS,
-    SPEED_BOUND,
-    HexapodGeometry,
-    parameter_specs,
-)
-from evorbc_ros.robots.primitive import ParameterSpec
-from sim_bridge.hexapod.evaluate import HEADING, PATH, TILT, X, Y
-from sim_bridge.hexapod.physics import PhysicsSettings
-from sim_bridge.hexapod.pool import EvaluationPool
-from sim_bridge.robots.base import PrimitiveOutcome, control_steps
+from evorbc_ros.robots.hexapod import HEXAPOD, HexapodGeometry
+from sim_bridge.hexapod.physics import PhysicsSettings, hexapod_robot_settings
+from sim_bridge.legged.robot import LeggedRobot
 
 #: Tilt (rad) beyond which an evaluation stops: eq. 6 discards the primitive anyway.
 DISCARD_TILT = np.radians(45.0)
@@ -34,8 +25,14 @@ def describe_simulation(geometry: HexapodGeometry, physics: PhysicsSettings) -> 
     return json.loads(json.dumps(described))  # as a file holds it: tuples become lists
 
 
-class HexapodRobot:
-    """The 18-joint hexapod in PyBullet, primitives evaluated on ``workers`` processes."""
+class HexapodRobot(LeggedRobot):
+    """The 18-joint hexapod in PyBullet, primitives evaluated on ``workers`` processes.
+
+    The legged robot (:class:`~sim_bridge.legged.robot.LeggedRobot`) of
+    :func:`~sim_bridge.hexapod.physics.hexapod_robot_settings`: 37 parameters of eq. 11,
+    primitives tilting past 45 deg stop early (the circular+tilt metric discards them).
+    Its files record the hexapod's geometry and physics, as they always did.
+    """
 
     name = HEXAPOD
 
@@ -45,48 +42,14 @@ class HexapodRobot:
         physics: PhysicsSettings | None = None,
         workers: int | None = None,
     ) -> None:
+        settings = hexapod_robot_settings(geometry, physics)
         self.geometry = geometry or HexapodGeometry()
         self.physics = physics or PhysicsSettings()
-        self.control_period = self.geometry.control_period
-        self.pool = EvaluationPool(self.geometry, self.physics, workers)
-
-    @property
-    def parameter_specs(self) -> tuple[ParameterSpec, ...]:
-        """The 37 parameters of eq. 11 (genes in [-1, 1])."""
-        return parameter_specs()
-
-    def max_reach(self, eval_time: float) -> float:
-        """An upper bound (m) on any primitive's displacement after ``eval_time`` s."""
-        return SPEED_BOUND * eval_time
-
-    def evaluate_primitives(self, genes: np.ndarray, eval_time: float) -> PrimitiveOutcome:
-        """Execute ``(n, 37)`` primitives from rest for ``eval_time`` s (in parallel).
-
-        Primitives that tilt past 45 deg stop early; their outcome is where they were
-        then, with ``max_tilt`` above the limit (the circular+tilt metric discards them).
-        """
-        genes = np.atleast_2d(np.asarray(genes, dtype=np.float64))
-        if genes.shape[1] != N_PARAMETERS:
-            raise ValueError(
-                f"hexapod primitives have {N_PARAMETERS} parameters, got {genes.shape[1]}"
-            )
-        control_steps(eval_time, self.control_period)
-        rows = self.pool.evaluate(genes, eval_time, self.control_period, DISCARD_TILT)
-        return PrimitiveOutcome(
-            x=rows[:, X],
-            y=rows[:, Y],
-            heading=rows[:, HEADING],
-            path=rows[:, PATH],
-            max_tilt=rows[:, TILT],
-        )
+        super().__init__(settings, workers)
 
     def describe(self) -> dict:
         """Plain-data description of the simulated robot (recorded in repertoire files)."""
         return describe_simulation(self.geometry, self.physics)
-
-    def close(self) -> None:
-        """Stop the worker processes."""
-        self.pool.close()
 
 
 def simulated_robot(robot, workers: int | None = None) -> HexapodRobot:

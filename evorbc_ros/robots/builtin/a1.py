@@ -19,5 +19,9 @@ ROBOTS = (
         # Standard NEAT's extra generations at equal budget: a Table I repertoire's
         # simulated time (1.025M x 2 s) in generations of 150 x 30 s episodes.
         equal_budget_generations=455,
+        # EvoRBC seed 1 of the A1 comparison over the reduced repertoire (docs/a1.md,
+        # evorbc_ros/data/README.md).
+        shipped_repertoire="a1.repertoire.json",
+        shipped_arbitrator="a1.arbitrator.json",
     ),
 )
