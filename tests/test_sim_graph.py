@@ -266,7 +266,7 @@ def test_a_robot_without_a_shipped_controller_says_how_to_make_one(capsys, no_gr
     code, err = run_sim(capsys, "--robot", "2ws-2")
     assert code == 1
     assert err == [
-        "evorbc-sim: error: no controller ships for robot 2ws-2 (only for 4ws-5 and hexapod); "
+        "evorbc-sim: error: no controller ships for robot 2ws-2 (only for 4ws-5, a1 and hexapod); "
         "make one with 'evorbc-evolve repertoire --robot 2ws-2 --seed 1 --out r.json' and "
         "'evorbc-evolve arbitrator --repertoire r.json --seed 1 --out a.json', then run "
         "'evorbc-sim --arbitrator a.json --repertoire r.json'"
