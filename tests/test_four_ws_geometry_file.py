@@ -150,7 +150,10 @@ HEAD = "kind: four_ws\ntype: 4ws-5\n"
             "geometry: footprint_radius 0.05 m must hold the wheels at (0.2, 0.025) m",
         ),
         ("kind: four_ws\ntype: 6ws\n", "type must be one of 2ws-2, 2ws-3, 4ws-3, 4ws-5"),
-        ("kind: four_wheels\n", "kind must be one of four_ws, diff_drive, legged; got 'four_wheels'"),
+        (
+            "kind: four_wheels\n",
+            "kind must be one of four_ws, diff_drive, legged; got 'four_wheels'",
+        ),
     ],
 )
 def test_a_bad_4ws_file_is_one_line_naming_file_and_key(user_robots, text, message):
