@@ -16,7 +16,7 @@ from neat_helpers import neat_config, network_spec, random_genomes
 from evorbc_ros.arbitrator import ArbitratorFile
 from offline_evolution.cli import main
 from offline_evolution.maze_task.legged_task import LeggedMazeTask
-from offline_evolution.maze_task.perturbation import APPLIES, QUANTITIES, PerturbationSet
+from offline_evolution.maze_task.perturbation import PYBULLET_LEGGED, QUANTITIES, PerturbationSet
 from offline_evolution.maze_task.task import MazeTaskSettings
 from sim_bridge.legged.perturbed import perturbed_ranges, perturbed_sim
 from sim_bridge.legged.physics import LeggedSim
@@ -58,8 +58,8 @@ def world_row(**values) -> dict:
 
 def test_the_a1_is_a_perturbable_legged_robot(a1):
     task = a1[0]
-    assert task.perturbation_family == "pybullet-legged"
-    assert set(APPLIES[task.perturbation_family]) == set(QUANTITIES) - {"wheel_speed_gain"}
+    assert task.perturbations_applied == PYBULLET_LEGGED
+    assert set(PYBULLET_LEGGED) == set(QUANTITIES) - {"wheel_speed_gain"}
 
 
 @pytest.mark.parametrize(
@@ -167,7 +167,7 @@ def test_evorbc_evolve_evaluates_the_a1_in_realistic_worlds(a1, tmp_path, capsys
     assert report["perturbation"]["name"] == "realistic"
     assert report["overall"]["episodes"] == 2 and report["mazes"] == ["a1"]
     assert report["not_applicable"] == ["wheel_speed_gain"]
-    assert set(report["applied"]) == set(APPLIES["pybullet-legged"])
+    assert set(report["applied"]) == set(PYBULLET_LEGGED)
     # Other worlds, other starts (the drawn start errors) and other outcomes.
     for perturbed, plain in zip(report["episodes"], nominal["episodes"], strict=True):
         assert perturbed["start"] != plain["start"]

@@ -327,6 +327,6 @@ def test_shipped_generated_training_tasks_load(name):
 def test_perturbed_training_needs_a_simulation_that_takes_perturbations():
     task = MazeTask(MazeTaskSettings.from_dict(task_dict(perturb="realistic"), "t"), "4ws-5")
     task.start_training("4ws-5", 1, source="t.yaml")  # the kinematic kernel takes them
-    task.perturbation_family = None  # as a legged robot's task without perturbed worlds
+    task.perturbations_applied = ()  # as a robot's task's task without perturbed worlds
     with pytest.raises(ConfigError, match=r"t\.yaml: training: perturb realistic: 4ws-5's"):
         task.start_training("4ws-5", 1, source="t.yaml")

@@ -239,7 +239,7 @@ class MazeTaskBase(abc.ABC):
         check_training(self.task_mazes, self.settings.training, seed, source)
         if self.settings.training is not None:
             training = TrainingMazes(self.settings.training, robot)
-            if training.perturbed and getattr(self, "perturbation_family", None) is None:
+            if training.perturbed and not getattr(self, "perturbations_applied", ()):
                 raise ConfigError(
                     f"{source}: training: perturb {training.perturbation.name}: {robot}'s "
                     "simulation takes no perturbed worlds (use none)"

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from offline_evolution.maze_task.base import MazeTaskBase
-from offline_evolution.maze_task.perturbation import APPLIES, NONE, PerturbationSet
+from offline_evolution.maze_task.perturbation import NONE, PerturbationSet
 from offline_evolution.mazes.paths import solve
 
 #: s without progress along the maze that counts as a stall (capped at the episode time).
@@ -156,12 +156,12 @@ def evaluate_suite(
         ]
     )
     world = None
-    family = getattr(task, "perturbation_family", None)
+    takes = tuple(getattr(task, "perturbations_applied", ()))
     wanted = perturbation.perturbed()
-    applied = tuple(q for q in wanted if family and q in APPLIES[family])
+    applied = tuple(q for q in wanted if q in takes)
     missing = tuple(q for q in wanted if q not in applied)
     if perturbation is not NONE:
-        if family is None:
+        if not takes:
             raise ValueError("this robot's maze task takes no perturbations")
         world = perturbation.draw(np.random.default_rng([seed, 1]), len(starts))
         starts = world.shift_starts(starts, task.mazes, task.footprint_radius)

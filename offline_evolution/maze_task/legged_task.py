@@ -20,6 +20,7 @@ from evorbc_ros.network import NetworkSpec
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.primitive import ParameterSpec
 from offline_evolution.maze_task.base import MazeTaskBase, MazeTaskSettings, empty_traces
+from offline_evolution.maze_task.perturbation import PYBULLET_LEGGED
 from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.legged.episode import EpisodeRunner, LeggedController, LeggedWorld
 from sim_bridge.legged.pool import SpawnedWorkers, available_cores, ignore_sigint
@@ -58,9 +59,8 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
 
     """
 
-    #: Its simulation's kind, for what a perturbation set can change (docs/design.md
-    #: section 21).
-    perturbation_family = "pybullet-legged"
+    #: What of a perturbation set its simulation applies (docs/design.md section 21).
+    perturbations_applied = PYBULLET_LEGGED
 
     def __init__(
         self,

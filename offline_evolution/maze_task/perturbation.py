@@ -3,7 +3,9 @@
 A *perturbation set* (``config/perturbations/*.yaml``, docs/design.md section 21) gives a
 ``[low, high]`` range per quantity; each episode (each start row) draws one value of each,
 uniformly, from a seeded generator. :class:`WorldDraw` holds the draws, one row per start,
-and a maze task applies those its simulation has (:data:`APPLIES`):
+and a maze task applies those its simulation has, which it lists in its
+``perturbations_applied`` (:data:`KINEMATIC`, :data:`PYBULLET_LEGGED`; a plugin's task
+lists its own):
 
 * the 4WS robots' kinematic model (``sim_bridge/four_ws_motion.py``) has no friction, mass
   or servos; it takes the wheel speed gain, the latency, the rangefinder noise and
@@ -43,29 +45,29 @@ QUANTITIES = {
     "start_position": (0.0, 0.0, 1.0),
     "start_heading_deg": (0.0, 0.0, 180.0),
 }
-#: What each robot family's simulation applies (the rest it cannot model).
-APPLIES = {
-    "kinematic": (
-        "wheel_speed_gain",
-        "latency_cycles",
-        "range_noise",
-        "dropout",
-        "start_position",
-        "start_heading_deg",
-    ),
-    "pybullet-legged": (
-        "friction",
-        "body_mass",
-        "payload",
-        "servo_strength",
-        "servo_speed",
-        "latency_cycles",
-        "range_noise",
-        "dropout",
-        "start_position",
-        "start_heading_deg",
-    ),
-}
+#: What the 4WS and differential-drive robots' kinematic model applies (no friction,
+#: mass or servos).
+KINEMATIC = (
+    "wheel_speed_gain",
+    "latency_cycles",
+    "range_noise",
+    "dropout",
+    "start_position",
+    "start_heading_deg",
+)
+#: What the legged robots' PyBullet simulation applies (no wheels).
+PYBULLET_LEGGED = (
+    "friction",
+    "body_mass",
+    "payload",
+    "servo_strength",
+    "servo_speed",
+    "latency_cycles",
+    "range_noise",
+    "dropout",
+    "start_position",
+    "start_heading_deg",
+)
 
 
 @dataclass(frozen=True)

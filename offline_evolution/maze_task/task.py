@@ -26,6 +26,7 @@ from offline_evolution.maze_task.base import (
     eq5_fitness,
 )
 from offline_evolution.maze_task.kernel import EVORBC, STANDARD, run_episodes
+from offline_evolution.maze_task.perturbation import KINEMATIC
 from offline_evolution.maze_task.world import MazePiece, combine_pieces, maze_piece
 from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.robots.diff_drive import DiffDriveRobot
@@ -125,9 +126,9 @@ class MazeTask(MazeTaskBase):
 
     """
 
-    #: Its simulation's kind, for what a perturbation set can change (kinematic: no
+    #: What of a perturbation set its simulation applies (the kinematic model: no
     #: friction, mass or servos; docs/design.md section 21).
-    perturbation_family = "kinematic"
+    perturbations_applied = KINEMATIC
 
     def __init__(self, settings: MazeTaskSettings, robot: str | KinematicRobot):
         if isinstance(robot, str):
