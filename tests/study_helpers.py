@@ -7,8 +7,9 @@ import sys
 import time
 from pathlib import Path
 
-#: Two EvoRBC runs of the 2ws-2 robot with a small repertoire budget and 12 generations
-#: (the first NEAT checkpoint is written after generation 10).
+#: Two EvoRBC runs of the 2ws-2 robot with a small repertoire budget and 20 generations
+#: (a NEAT checkpoint is written after generation 10 and stays until the run ends, a
+#: window long enough to find both runs between their checkpoint and their end).
 TINY_STUDY = """
 study: tiny
 seeds: 2
@@ -19,7 +20,7 @@ fixed:
   initial_batch: 500
   batch_size: 100
   iterations: 20
-  generations: 12
+  generations: 20
 """
 
 #: Keys that hold measured times, which differ between any two runs.
@@ -73,3 +74,8 @@ def wait_for(condition, timeout: float, what: str):
 
 def first_checkpoint(results: Path):
     return next(results.rglob("arbitrator.json.checkpoint.json"), None)
+
+
+def checkpoints(results: Path) -> int:
+    """How many runs are between their first NEAT checkpoint and their end."""
+    return len(list(results.rglob("arbitrator.json.checkpoint.json")))

@@ -5,7 +5,7 @@ import subprocess
 import pytest
 from ray_cluster import LocalCluster, free_port
 from study_helpers import (
-    first_checkpoint,
+    checkpoints,
     results_contents,
     run_study,
     study_command,
@@ -37,9 +37,9 @@ def test_a_study_survives_losing_a_node_with_results_identical_to_a_serial_run(
         text=True,
         env=cluster.env,
     )
-    # Both runs go at once, one per node; once one has saved a NEAT checkpoint, the
-    # worker node is lost with whatever it was running.
-    wait_for(lambda: first_checkpoint(results), 300, "a NEAT checkpoint")
+    # Both runs go at once, one per node; once both have saved a NEAT checkpoint (so
+    # neither has finished), the worker node is lost with the run it was running.
+    wait_for(lambda: checkpoints(results) == 2, 300, "both runs' NEAT checkpoints")
     cluster.kill_worker_node()
     out, _ = proc.communicate(timeout=600)
     assert proc.returncode == 0, out

@@ -81,8 +81,8 @@ def test_a_finished_run_holds_its_files_and_record(serial_results):
         "run.log",
     ]
     record = json.loads((run / "run.json").read_text())
-    assert record["settings"]["seed"] == 1 and record["settings"]["generations"] == 12
-    assert record["summary"]["generations"] == 12
+    assert record["settings"]["seed"] == 1 and record["settings"]["generations"] == 20
+    assert record["summary"]["generations"] == 20
     assert record["seconds"] > 0 and record["cpu_seconds"] > 0
 
 
@@ -97,7 +97,7 @@ def test_finished_runs_are_skipped_and_other_settings_refused(serial_results):
         "--generations", "30",
     )  # fmt: skip
     assert other.returncode == 1
-    assert "was run with generations = 12, not 30; use another results folder" in other.stderr
+    assert "was run with generations = 20, not 30; use another results folder" in other.stderr
 
 
 def test_a_killed_study_resumes_to_the_uninterrupted_results(serial_results, tmp_path):
@@ -160,7 +160,7 @@ def test_the_report_comes_from_the_results_folder_alone(serial_results, tmp_path
     assert result.returncode == 0, result.stderr
     text = (out / "tiny.md").read_text()
     assert "* Runs finished: 2, 2 seeds per setting (the full protocol has 2)." in text
-    assert "* NEAT generations per run: 12" in text
+    assert "* NEAT generations per run: 20" in text
     record = json.loads((serial_results / "approach-evorbc" / "seed-001" / "run.json").read_text())
     best = [record["summary"]["best_fitness"]]
     record2 = json.loads((serial_results / "approach-evorbc" / "seed-002" / "run.json").read_text())
