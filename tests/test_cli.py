@@ -151,7 +151,7 @@ def test_ctrl_c_saves_a_checkpoint_and_the_same_command_resumes(tmp_path):
         "--batch-size",
         "1000",
         "--iterations",
-        "500",
+        "150",
         "--checkpoint-every",
         "1000000",
         "--out",

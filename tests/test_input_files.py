@@ -61,8 +61,13 @@ def fifo(tmp_path):
     thread.start()
     yield path
     stop.set()
-    os.close(os.open(path, os.O_RDONLY | os.O_NONBLOCK))  # lets the feeder's open return
-    thread.join(5)
+    # Let the feeder's blocking open return, again until it has seen `stop`: a reader the
+    # test opened may have woken it just before, so that it blocks in a new open.
+    for _ in range(100):
+        os.close(os.open(path, os.O_RDONLY | os.O_NONBLOCK))
+        thread.join(0.05)
+        if not thread.is_alive():
+            break
 
 
 def test_export_csv_refuses_a_fifo_at_once(tmp_path, fifo):

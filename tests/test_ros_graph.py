@@ -21,6 +21,11 @@ from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
 from sim_bridge.bringup import NODES, node_command
 
 MAZES = ["obstacle", "zigzag", "baffles", "corridors", "gaps"]
+#: The mazes whose whole episode goes through the graph: the two shortest episodes, to keep
+#: the suite short. The graph's parity does not depend on the walls; `obstacle` and
+#: `baffles` go through the graph with parity checks in test_laser_graph.py and
+#: test_nonfinite_outputs.py, `zigzag` in the real-time test below.
+GRAPH_MAZES = ["corridors", "gaps"]
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +38,7 @@ def offline():
     return outcomes, result
 
 
-@pytest.mark.parametrize("k", range(len(MAZES)), ids=MAZES)
+@pytest.mark.parametrize("k", [MAZES.index(m) for m in GRAPH_MAZES], ids=GRAPH_MAZES)
 def test_lockstep_graph_makes_the_offline_choices_and_reaches_the_target(tmp_path, offline, k):
     outcomes, result = offline
     run = GraphRun(tmp_path, 150 + k, MAZES[k])
