@@ -167,17 +167,12 @@ class SimBridgeNode(Node):
             StartupError: the robot does not fit the maze where it starts (nominal or
                 random start), or an explicit ``start`` is malformed or touches a wall.
         """
-        x, y, _ = maze.start_pose
-        room = maze.clearance(x, y)
-        if start in ("nominal", "random") and room < clearance:
+        misfit = maze.start_misfit(clearance, robot)
+        if start in ("nominal", "random") and misfit:
             # Not the user's start: the maze's own start region is too narrow for it.
             own = registry.lookup(robot).maze if registry.known(robot) else maze.name
             hint = "" if maze.name == own else f"; its maze is {own}"
-            raise StartupError(
-                f"robot {robot} does not fit maze {maze.name}: at the maze's start "
-                f"({x:.2f}, {y:.2f}) m the nearest wall is {room:.3f} m away, and the robot "
-                f"needs {clearance:.3f} m{hint}"
-            )
+            raise StartupError(misfit + hint)
         if start == "random":
             try:
                 return tuple(maze.sample_starts(np.random.default_rng(seed), 1, clearance)[0])

@@ -76,6 +76,22 @@ class Maze:
         """Distance (m) from ``(x, y)`` to the nearest wall surface."""
         return float(clearance(x, y, self.boxes, self._all_walls))
 
+    def start_misfit(self, robot_radius: float, robot: str = "the robot") -> str | None:
+        """Why a robot of footprint radius ``robot_radius`` (m) cannot start here, or None.
+
+        The nominal start pose must clear the footprint, as random starts do: a start
+        inside a wall would begin an episode in contact (the 4WS model cannot leave it).
+        """
+        x, y, _ = self.start_pose
+        room = self.clearance(x, y)
+        if room >= robot_radius:
+            return None
+        return (
+            f"robot {robot} does not fit maze {self.name}: at the maze's start "
+            f"({x:.2f}, {y:.2f}) m the nearest wall is {room:.3f} m away, and the robot "
+            f"needs {robot_radius:.3f} m"
+        )
+
     def clearances(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Vectorised :meth:`clearance` for arrays of points (m)."""
         x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))

@@ -12,6 +12,7 @@ from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.registry import ROBOT_NAMES, lookup
 from offline_evolution.commands.common import (
+    CliError,
     add_workers_option,
     at_least,
     check_distinct,
@@ -197,12 +198,13 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     neat_file = Path(args.neat_config) if args.neat_config else run.neat_path()
     task_settings = MazeTaskSettings.load(args.task or run.task_path())
     # Held-out mazes and seeds are refused before any work (docs/design.md section 22).
-    check_training(
-        [load_named_maze(n) for n in task_settings.mazes],
-        task_settings.training,
-        args.seed,
-        str(args.task or run.task_path()),
-    )
+    task_mazes = [load_named_maze(n) for n in task_settings.mazes]
+    check_training(task_mazes, task_settings.training, args.seed, str(args.task or run.task_path()))
+    # Every nominal start must clear the robot's footprint (replay and the bridge use it).
+    for maze in task_mazes:
+        misfit = maze.start_misfit(lookup(robot).footprint_radius, robot)
+        if misfit:
+            raise CliError(f"{args.task or run.task_path()}: mazes: {misfit}")
     settings = EvolutionSettings(
         kind=args.kind,
         robot=robot,

@@ -158,14 +158,27 @@ class MazeTaskBase(abc.ABC):
     Args:
         settings: the task.
         dt: s, the robot's control period.
-        footprint_radius: m, how far a random start keeps the robot's centre from walls.
+        footprint_radius: m, how far a start keeps the robot's centre from walls.
+        robot_name: how an error names the robot.
 
     """
 
-    def __init__(self, settings: MazeTaskSettings, dt: float, footprint_radius: float):
+    def __init__(
+        self,
+        settings: MazeTaskSettings,
+        dt: float,
+        footprint_radius: float,
+        robot_name: str = "the robot",
+    ):
         self.settings = settings
         #: The task's own mazes (``settings.mazes``), always first in :attr:`mazes`.
         self.task_mazes: tuple[Maze, ...] = tuple(load_named_maze(n) for n in settings.mazes)
+        # Replay, the post-selection and the ROS bridge start at a maze's nominal pose, so
+        # it must clear the footprint as random starts do (the bridge refuses it too).
+        for maze in self.task_mazes:
+            misfit = maze.start_misfit(footprint_radius, robot_name)
+            if misfit:
+                raise ConfigError(f"mazes: {misfit}")
         #: The mazes episodes run in (start rows' maze column): the task's own, then the
         #: generated ones of the current draw (:meth:`generation_episodes`).
         self.mazes: list[Maze] = list(self.task_mazes)

@@ -73,7 +73,7 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
         self.robot = robot
         if robot.footprint_radius is None:
             raise ConfigError(f"{robot.source}: footprint_radius: needed for the maze task")
-        super().__init__(settings, robot.control_period, robot.footprint_radius)
+        super().__init__(settings, robot.control_period, robot.footprint_radius, robot.name)
         if self.layout.rangefinders is None:
             raise ConfigError(f"{settings.sensors}: the {robot.name}'s laser needs rangefinders")
         try:  # here, not first in a worker, so that the error names the file

@@ -136,7 +136,7 @@ class MazeTask(MazeTaskBase):
 
             robot = lookup(robot).make_simulation()
         self.robot = robot
-        super().__init__(settings, robot.control_period, robot.footprint_radius)
+        super().__init__(settings, robot.control_period, robot.footprint_radius, robot.name)
         self.sensors = compile_layout(self.layout)
         # Walls a ray or the footprint can touch from a cell: sensor reach plus a step and
         # a margin (m).
