@@ -7,7 +7,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.evorbc-installed
 OUT    ?= demo-output
 
-.PHONY: demo demo-hexapod demo-a1 demo-repertoire demo-evolve test lint bench clean
+.PHONY: demo demo-hexapod demo-a1 demo-repertoire demo-evolve test test-fast lint bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -56,6 +56,11 @@ lint: $(STAMP)
 
 test: lint
 	$(PY) -m pytest -q
+
+# The suite without the tests marked slow (Ray clusters, killed and resumed runs, full
+# budgets, the plugin package): a few minutes, for working on the code.
+test-fast: lint
+	$(PY) -m pytest -q -m "not slow"
 
 bench: $(STAMP)
 	$(PY) bench/bench_repertoire.py

@@ -135,6 +135,7 @@ def test_bad_yaml_and_corrupt_checkpoint(tmp_path, capsys):
     assert (tmp_path / "r.json.checkpoint.npz").read_bytes() == b"not a checkpoint"
 
 
+@pytest.mark.slow
 def test_ctrl_c_saves_a_checkpoint_and_the_same_command_resumes(tmp_path):
     out = tmp_path / "r.json"
     cmd = [

@@ -5,6 +5,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 EXAMPLES = Path(__file__).parents[1] / "docs" / "examples"
 
 
@@ -15,6 +17,7 @@ def run_example(name: str, *args) -> str:
     return out.stdout
 
 
+@pytest.mark.slow
 def test_own_evaluation_evolves_saves_and_drives_a_unicycle_with_its_repertoire(tmp_path):
     first = tmp_path / "a.json"
     lines = run_example("own_evaluation.py", "--out", first, "--seed", 2).splitlines()

@@ -183,6 +183,7 @@ def test_repertoire_carries_its_settings_and_summary(small_repertoire):
     assert len({tuple(c) for c in cells}) == len(r)
 
 
+@pytest.mark.slow
 def test_full_table_one_budget_gives_a_high_quality_4ws5_repertoire():
     # Paper Sec. IV-D: "MAP-Elites is able to evolve high-quality repertoires" (1.01M evals).
     r = generate_repertoire(load_settings(robot="4ws-5", seed=1))
@@ -216,6 +217,7 @@ def test_iso_line_dd_children_lie_near_the_line_through_two_elites():
     assert np.mean(near_parent < 0.06) == pytest.approx(0.5 + 0.5 * 0.23, abs=0.03)
 
 
+@pytest.mark.slow
 def test_cvt_archive_is_mirror_symmetric_with_as_many_cells_as_the_grid():
     layout = cvt_layout(max_reach=0.4, bin_size=0.04, seed=2)
     assert layout["cells"] == 21 * 21 - 1 and layout["low"] == grid_layout(0.4, 0.04)["low"]
@@ -230,6 +232,7 @@ def test_cvt_archive_is_mirror_symmetric_with_as_many_cells_as_the_grid():
     assert layout == cvt_layout(max_reach=0.4, bin_size=0.04, seed=2)  # seeded
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "archive, variation", [("grid", "iso_line_dd"), ("cvt", "paper"), ("cvt", "iso_line_dd")]
 )

@@ -47,6 +47,7 @@ def cli(tmp_path, command, *args):
     return out
 
 
+@pytest.mark.slow
 def test_a_robot_in_its_own_package_goes_through_the_whole_pipeline(tmp_path, plugin):
     from evorbc_ros.arbitrator import ArbitratorFile
     from evorbc_ros.repertoire import Repertoire

@@ -77,6 +77,7 @@ def installed_env(prefix: Path) -> dict:
     )
 
 
+@pytest.mark.slow
 def test_the_ament_index_finds_both_packages(prefix, tmp_path):
     script = (
         "from ament_index_python.packages import get_package_prefix, "

@@ -72,6 +72,7 @@ def test_an_unknown_study_lists_the_known_ones():
     ]
 
 
+@pytest.mark.slow
 def test_a_finished_run_holds_its_files_and_record(serial_results):
     run = serial_results / "approach-evorbc" / "seed-001"
     assert sorted(p.name for p in run.iterdir()) == [
@@ -86,6 +87,7 @@ def test_a_finished_run_holds_its_files_and_record(serial_results):
     assert record["seconds"] > 0 and record["cpu_seconds"] > 0
 
 
+@pytest.mark.slow
 def test_finished_runs_are_skipped_and_other_settings_refused(serial_results):
     before = (serial_results / "approach-evorbc" / "seed-002" / "run.json").read_text()
     again = run_study("run", serial_results.parent / "tiny.yaml", "--results", serial_results)
@@ -100,6 +102,7 @@ def test_finished_runs_are_skipped_and_other_settings_refused(serial_results):
     assert "was run with generations = 20, not 30; use another results folder" in other.stderr
 
 
+@pytest.mark.slow
 def test_a_killed_study_resumes_to_the_uninterrupted_results(serial_results, tmp_path):
     study = write_tiny_study(tmp_path)
     results = tmp_path / "results"
@@ -122,6 +125,7 @@ def test_a_killed_study_resumes_to_the_uninterrupted_results(serial_results, tmp
     assert results_contents(results) == results_contents(serial_results)
 
 
+@pytest.mark.slow
 def test_a_second_runner_on_the_same_results_is_refused(tmp_path):
     study = write_tiny_study(tmp_path)
     results = tmp_path / "results"
@@ -152,6 +156,7 @@ def test_the_study_file_is_checked_before_anything_runs(tmp_path):
     assert not (tmp_path / "r").exists()
 
 
+@pytest.mark.slow
 def test_the_report_comes_from_the_results_folder_alone(serial_results, tmp_path):
     out = tmp_path / "report"
     result = run_study(
