@@ -7,11 +7,23 @@ set -e
 name=$1; seed=${2:-1}; gens=${3:-300}
 dir=docs/runs/generalise
 out=$dir/$name-seed$seed
-.venv/bin/evorbc-evolve arbitrator --repertoire evorbc_ros/data/4ws-5.repertoire.json \
-  --task $dir/tasks/$name.yaml --seed $seed --generations $gens --workers 1 --quiet \
-  --out $out.arbitrator.json --checkpoint $out.checkpoint.json
-for suite in paper held; do
-  if [ $suite = paper ]; then extra=""; else extra="--generated 50"; fi
+if [ ! -f $out.arbitrator.json ] || [ -f $out.checkpoint.json ]; then
+  .venv/bin/evorbc-evolve arbitrator --repertoire evorbc_ros/data/4ws-5.repertoire.json \
+    --task $dir/tasks/$name.yaml --seed $seed --generations $gens --workers 1 --quiet \
+    --out $out.arbitrator.json --checkpoint $out.checkpoint.json
+fi
+# A run trained with other episodes than the others is evaluated like them: tasks/NAME.eval.yaml.
+evaltask=""
+[ -f $dir/tasks/$name.eval.yaml ] && evaltask="--task $dir/tasks/$name.eval.yaml"
+# paper: the five paper mazes; held: the 50 held-out mazes; heldr: those under `realistic`.
+for suite in paper held heldr; do
+  [ -f $out.$suite.json ] && continue
+  case $suite in
+    paper) extra="$evaltask --perturb none" ;;
+    held) extra="--generated 50 $evaltask --perturb none" ;;
+    heldr) extra="--generated 50 $evaltask --perturb realistic" ;;
+  esac
   .venv/bin/evorbc-evolve evaluate --arbitrator $out.arbitrator.json $extra --starts 20 \
-    --perturb none --repertoire evorbc_ros/data/4ws-5.repertoire.json --json | .venv/bin/python $dir/summary.py > $out.$suite.json
+    --repertoire evorbc_ros/data/4ws-5.repertoire.json --json | .venv/bin/python $dir/summary.py > $out.$suite.tmp
+  mv $out.$suite.tmp $out.$suite.json
 done
