@@ -248,10 +248,10 @@ def activate_packed(pack: NetworkPack, g: int, inputs) -> np.ndarray:
 
 
 def activate_packed_sequence(pack: NetworkPack, g: int, inputs) -> np.ndarray:
-    """Network ``g`` of ``pack`` over ``inputs (T, n_inputs)`` from a zero state: ``(T, n_outputs)``.
+    """Network ``g`` of ``pack`` over ``inputs (T, n_inputs)``, from a zero state.
 
-    Recurrent networks carry their state from row to row; feed-forward ones do not
-    (tests and tools).
+    Returns ``(T, n_outputs)``. Recurrent networks carry their state from row to row;
+    feed-forward ones do not (tests and tools).
     """
     rows = np.asarray(inputs, dtype=np.float64)
     buffers = np.zeros((2, int(pack.n_slots.max())))
