@@ -11,9 +11,11 @@ Prints, for this machine:
   * peak memory (max RSS of the process).
 
 With ``--kernel-only`` it prints the kernel rates alone, for feed-forward networks
-(``config/neat/4ws.ini``) and, where the tree has them, recurrent ones
-(``4ws-recurrent.ini``: the same initial population but the networks keep state, so the
-fixed-point exit needs their two buffers equal too). To compare two source trees A/B,
+(``config/neat/4ws.ini``) and, where the tree has them, recurrent ones: "as recurrent" runs
+the same feed-forward population through the recurrent path (the same outputs, so the
+cost of the path alone), "recurrent" the initial population of ``4ws-recurrent.ini``, whose
+genomes neat-python starts with a self-loop on every output (other networks, other
+episodes: fewer reach a fixed point and stop early). To compare two source trees A/B,
 run it alternately with each tree first on ``PYTHONPATH``, e.g.
 ``PYTHONPATH=/tmp/old .venv/bin/python bench/bench_arbitrator.py --kernel-only``.
 
@@ -24,6 +26,7 @@ a repertoire: the Table I 4ws-5 repertoire (seed 1) is generated first (about 2 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import resource
 import statistics
 import time
@@ -52,11 +55,20 @@ from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
 
 
-def kernel_rate(task, controller, n_outputs, threads: int, neat_file: str = "4ws.ini") -> float:
-    """Control cycles per second for one generation of the initial population."""
+def kernel_rate(
+    task, controller, n_outputs, threads: int, neat_file: str = "4ws.ini", as_recurrent=False
+) -> float:
+    """Control cycles per second for one generation of the initial population.
+
+    ``as_recurrent``: run the networks through the recurrent path (same outputs when they
+    have no hidden nodes, as at first).
+    """
     config = load_neat_config(config_dir() / "neat" / neat_file, task.layout.n_inputs, n_outputs)
     pop = neat.Population(config, seed=1)
-    pack = pack_networks([network_spec(g, config) for g in pop.population.values()])
+    specs = [network_spec(g, config) for g in pop.population.values()]
+    if as_recurrent:
+        specs = [dataclasses.replace(s, recurrent=True) for s in specs]
+    pack = pack_networks(specs)
     starts = task.sample_starts(np.random.default_rng(0))
     before = numba.get_num_threads()
     numba.set_num_threads(threads)
@@ -123,6 +135,8 @@ def main() -> None:
             print(f"kernel: {rate / 1e6:.2f} M control cycles/s with {t} thread(s)")
         if (config_dir() / "neat" / "4ws-recurrent.ini").exists():
             for t in sorted({1, threads}):
+                rate = kernel_rate(task, controller, n_out, t, as_recurrent=True)
+                print(f"kernel, as recurrent: {rate / 1e6:.2f} M control cycles/s, {t} thread(s)")
                 rate = kernel_rate(task, controller, n_out, t, "4ws-recurrent.ini")
                 print(f"kernel, recurrent: {rate / 1e6:.2f} M control cycles/s with {t} thread(s)")
         if args.kernel_only:
