@@ -193,6 +193,39 @@ def test_episodes_reset_the_state_and_the_fixed_point_exit_stays_exact():
     assert len({tuple(r) for r in full.choice[:, :50].tolist()}) > 2  # they drive about
 
 
+def ramp_network(n_inputs: int, flip_at: float = 0.6) -> NetworkSpec:
+    """A standard-NEAT 4WS controller with a clock: hidden node 10 ramps by 0.01 a cycle
+    (a clamped self-loop); the speed gene is +1 until the ramp passes ``flip_at`` (cycle
+    60), then -1; the other genes are 0 (straight wheels)."""
+    nodes = [NodeSpec(k, 0.0, 1.0, "sigmoid", "sum") for k in range(1, 5)]
+    nodes += [
+        NodeSpec(0, 1000.0 * flip_at, 1.0, "sigmoid", "sum"),
+        NodeSpec(10, 0.01, 1.0, "clamped", "sum"),
+    ]
+    connections = [ConnectionSpec(-1, k, 0.0) for k in range(1, 5)]
+    connections += [ConnectionSpec(10, 10, 1.0), ConnectionSpec(10, 0, -1000.0)]
+    inputs = tuple(-i - 1 for i in range(n_inputs))
+    return NetworkSpec(inputs, tuple(range(5)), tuple(nodes), tuple(connections), True)
+
+
+def test_a_robot_stuck_while_its_network_still_changes_is_not_stopped_early():
+    """The robot drives into a wall and stands (pose, speed and wheels unchanged) while
+    the network's clock runs on; at cycle 60 it reverses. A fixed-point exit that looked at
+    the robot alone would end the episode at the wall."""
+    from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
+
+    task = MazeTask(MazeTaskSettings(("corridors", "gaps"), 30.0), "4ws-5")
+    controller = task.controller("standard", None, None)
+    spec = ramp_network(task.layout.n_inputs)
+    fast = task.evaluate([spec], controller, task.nominal_starts())
+    full = task.evaluate([spec], controller, task.nominal_starts(), record=True)
+    for key in ("reached", "cycles", "final_distance", "fitness"):
+        np.testing.assert_array_equal(getattr(fast, key), getattr(full, key))
+    for e in range(2):
+        moved = np.any(np.diff(full.pose[e], axis=0) != 0.0, axis=1)
+        assert not moved[45:60].any() and moved[62:70].any()  # stuck, then backs away
+
+
 def test_feed_forward_networks_in_files_still_refuse_cycles():
     spec = NetworkSpec(
         input_keys=(-1,),
