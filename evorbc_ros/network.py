@@ -305,7 +305,7 @@ class CompiledRecurrentNetwork(CompiledNetwork):
     recurrent: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "_buffers", ([0.0] * self.n_slots, [0.0] * self.n_slots))
+        self.reset()
 
     def reset(self) -> None:
         """Set every value to 0, as at the start of an episode."""
