@@ -5,7 +5,8 @@ An arbitrator file is JSON, versioned, never pickled::
     {"format": "evorbc-arbitrator", "version": 1,
      "kind": "evorbc",                 # or "standard": the network drives the parameters
      "robot": "4ws-5",
-     "network": {...},                 # evorbc_ros.network.NetworkSpec.to_dict()
+     "network": {...},                 # evorbc_ros.network.NetworkSpec.to_dict(); with
+                                       # "recurrent": true if it keeps state
      "inputs": ["range_000", ...],     # one name per network input
      "sensors": {...},                 # evorbc_ros.sensors.SensorLayout.to_dict()
      "sensors_fingerprint": "...",
