@@ -10,13 +10,23 @@ Prints, for this machine:
     1000, or measured in full with ``--full``;
   * peak memory (max RSS of the process).
 
-Run: ``.venv/bin/python bench/bench_arbitrator.py [--full]``. EvoRBC needs a repertoire:
-the Table I 4ws-5 repertoire (seed 1) is generated first (about 2 s).
+With ``--kernel-only`` it prints the kernel rates alone, for feed-forward networks
+(``config/neat/4ws.ini``) and, where the tree has them, recurrent ones: "as recurrent" runs
+the same feed-forward population through the recurrent path (the same outputs, so the
+cost of the path alone), "recurrent" the initial population of ``4ws-recurrent.ini``, whose
+genomes neat-python starts with a self-loop on every output (other networks, other
+episodes: fewer reach a fixed point and stop early). To compare two source trees A/B,
+run it alternately with each tree first on ``PYTHONPATH``, e.g.
+``PYTHONPATH=/tmp/old .venv/bin/python bench/bench_arbitrator.py --kernel-only``.
+
+Run: ``.venv/bin/python bench/bench_arbitrator.py [--full | --kernel-only]``. EvoRBC needs
+a repertoire: the Table I 4ws-5 repertoire (seed 1) is generated first (about 2 s).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import resource
 import statistics
 import time
@@ -45,11 +55,20 @@ from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
 
 
-def kernel_rate(task, controller, n_outputs, threads: int) -> float:
-    """Control cycles per second for one generation of the initial population."""
-    config = load_neat_config(config_dir() / "neat" / "4ws.ini", task.layout.n_inputs, n_outputs)
+def kernel_rate(
+    task, controller, n_outputs, threads: int, neat_file: str = "4ws.ini", as_recurrent=False
+) -> float:
+    """Control cycles per second for one generation of the initial population.
+
+    ``as_recurrent``: run the networks through the recurrent path (same outputs when they
+    have no hidden nodes, as at first).
+    """
+    config = load_neat_config(config_dir() / "neat" / neat_file, task.layout.n_inputs, n_outputs)
     pop = neat.Population(config, seed=1)
-    pack = pack_networks([network_spec(g, config) for g in pop.population.values()])
+    specs = [network_spec(g, config) for g in pop.population.values()]
+    if as_recurrent:
+        specs = [dataclasses.replace(s, recurrent=True) for s in specs]
+    pack = pack_networks(specs)
     starts = task.sample_starts(np.random.default_rng(0))
     before = numba.get_num_threads()
     numba.set_num_threads(threads)
@@ -96,6 +115,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--generations", type=int, default=60)
     parser.add_argument("--full", action="store_true", help="run all 1000 generations")
+    parser.add_argument(
+        "--kernel-only", action="store_true", help="only the kernel rates (A/B comparisons)"
+    )
     args = parser.parse_args()
     generations = 1000 if args.full else args.generations
     print(f"machine: {machine()}")
@@ -111,6 +133,14 @@ def main() -> None:
         for t in sorted({1, threads}):
             rate = kernel_rate(task, controller, n_out, t)
             print(f"kernel: {rate / 1e6:.2f} M control cycles/s with {t} thread(s)")
+        if (config_dir() / "neat" / "4ws-recurrent.ini").exists():
+            for t in sorted({1, threads}):
+                rate = kernel_rate(task, controller, n_out, t, as_recurrent=True)
+                print(f"kernel, as recurrent: {rate / 1e6:.2f} M control cycles/s, {t} thread(s)")
+                rate = kernel_rate(task, controller, n_out, t, "4ws-recurrent.ini")
+                print(f"kernel, recurrent: {rate / 1e6:.2f} M control cycles/s with {t} thread(s)")
+        if args.kernel_only:
+            continue
         f = run_figures(kind, generations, repertoire)
         projected = f["per_generation"] * 1000 / 60
         what = "measured" if args.full else f"projected from {generations} generations"

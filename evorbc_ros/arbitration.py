@@ -58,6 +58,15 @@ class Controller:
             self.direct = DirectController(self.spec)
 
     @property
+    def recurrent(self) -> bool:
+        """Whether the network keeps state from one choice to the next."""
+        return self.spec.network.recurrent
+
+    def reset(self) -> None:
+        """Start an episode: a recurrent network's state back to 0 (no-op if feed-forward)."""
+        (self.arbitrator if self.repertoire is not None else self.direct).reset()
+
+    @property
     def parameter_names(self) -> list[str]:
         """Names of the genes published for the executor."""
         if self.repertoire is not None:
@@ -66,6 +75,8 @@ class Controller:
 
     def step(self, inputs: np.ndarray) -> tuple[np.ndarray, list[float]]:
         """Genes to run and a diagnostic row ``[m1, m2, x, y, primitive]`` (EvoRBC).
+
+        One call is one control cycle: a recurrent network steps once.
 
         When the network's outputs are not finite there is no primitive to run: the genes
         are empty (``(0,)``, published as an empty message that stops the robot at once)

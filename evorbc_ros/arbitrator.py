@@ -5,7 +5,8 @@ An arbitrator file is JSON, versioned, never pickled::
     {"format": "evorbc-arbitrator", "version": 1,
      "kind": "evorbc",                 # or "standard": the network drives the parameters
      "robot": "4ws-5",
-     "network": {...},                 # evorbc_ros.network.NetworkSpec.to_dict()
+     "network": {...},                 # evorbc_ros.network.NetworkSpec.to_dict(); with
+                                       # "recurrent": true if it keeps state
      "inputs": ["range_000", ...],     # one name per network input
      "sensors": {...},                 # evorbc_ros.sensors.SensorLayout.to_dict()
      "sensors_fingerprint": "...",
@@ -330,8 +331,15 @@ class Arbitrator:
         self.mapping = MappingFunction.for_behaviours(spec.mapping, repertoire.behaviour)
         self.lookup = PrimitiveLookup.build(repertoire.behaviour, self.mapping.domain(), grid_cells)
 
+    def reset(self) -> None:
+        """Start an episode: a recurrent network's state back to 0 (no-op if feed-forward)."""
+        self.network.reset()
+
     def outputs(self, inputs) -> np.ndarray:
-        """The network's mapping values ``m`` in [0, 1]^2 for sensor ``inputs``."""
+        """The network's mapping values ``m`` in [0, 1]^2 for sensor ``inputs``.
+
+        A recurrent network steps once per call (one control cycle).
+        """
         return self.network.activate(inputs)
 
     def choose(self, inputs) -> tuple[int, np.ndarray]:
@@ -358,6 +366,10 @@ class DirectController:
             raise ArbitratorError("an EvoRBC arbitrator needs its repertoire; use Arbitrator")
         self.spec = spec
         self.network = spec.network.compile()
+
+    def reset(self) -> None:
+        """Start an episode: a recurrent network's state back to 0 (no-op if feed-forward)."""
+        self.network.reset()
 
     def genes(self, inputs) -> np.ndarray | None:
         """Genes in [-1, 1] (one per locomotion parameter): sigmoid outputs mapped linearly.

@@ -1,4 +1,4 @@
-"""Feed-forward NEAT networks as plain data, compiled to arrays and evaluated onboard.
+"""NEAT networks as plain data, compiled to arrays and evaluated onboard.
 
 A :class:`NetworkSpec` is what an arbitrator file stores: nodes (bias, response,
 activation, aggregation), connections (source, target, weight, enabled) and the input and
@@ -11,6 +11,14 @@ Semantics follow neat-python's ``FeedForwardNetwork``: only nodes that some outp
 depends on are evaluated, each as ``activation(bias + response * aggregation(inputs))``
 over its enabled incoming connections in file order; a needed node with no enabled input
 outputs ``activation(bias + response * aggregation([]))``.
+
+A network marked ``recurrent`` (evolved with neat-python's ``feed_forward = False``) follows
+neat-python's ``RecurrentNetwork`` instead (docs/design.md section 8): two value buffers;
+each activation sets the inputs, then every evaluated node computes from the *previous*
+activation's values, so a signal crosses one connection per activation (one control
+cycle). Cycles are allowed; values start at 0 and :meth:`CompiledNetwork.reset` sets them
+to 0 again (the start of an episode). Needed nodes without an enabled incoming connection
+are never evaluated there and stay at 0.
 """
 
 from __future__ import annotations
@@ -19,6 +27,7 @@ import math
 from dataclasses import dataclass
 from functools import cached_property, reduce
 from operator import add
+from typing import ClassVar
 
 import numpy as np
 
@@ -121,15 +130,22 @@ class ConnectionSpec:
 
 @dataclass(frozen=True)
 class NetworkSpec:
-    """A feed-forward network in neat-python's terms."""
+    """A network in neat-python's terms: feed-forward, or ``recurrent`` (see the module)."""
 
     input_keys: tuple[int, ...]
     output_keys: tuple[int, ...]
     nodes: tuple[NodeSpec, ...]
     connections: tuple[ConnectionSpec, ...]
+    recurrent: bool = False
 
     def to_dict(self) -> dict:
-        """Plain-data form used in arbitrator files."""
+        """Plain-data form used in arbitrator files.
+
+        ``"recurrent": true`` is written only for a recurrent network: a feed-forward one
+        is written exactly as before the key existed, and a file without it is read as
+        feed-forward.
+        """
+        extra = {"recurrent": True} if self.recurrent else {}
         return {
             "inputs": list(self.input_keys),
             "outputs": list(self.output_keys),
@@ -147,6 +163,7 @@ class NetworkSpec:
                 {"source": c.source, "target": c.target, "weight": c.weight, "enabled": c.enabled}
                 for c in self.connections
             ],
+            **extra,
         }
 
     @classmethod
@@ -175,10 +192,11 @@ class NetworkSpec:
                     )
                     for c in data["connections"]
                 ),
+                recurrent=_flag(data.get("recurrent", False), "recurrent"),
             )
         except KeyError as e:
             raise NetworkError(f"missing key {e.args[0]!r} in the network") from None
-        except TypeError as e:
+        except (TypeError, AttributeError) as e:
             raise NetworkError(f"malformed network ({e})") from None
         spec.compile()  # validates structure
         return spec
@@ -186,9 +204,13 @@ class NetworkSpec:
     def compile(self) -> CompiledNetwork:
         """Arrays in evaluation order (see :class:`CompiledNetwork`).
 
+        A recurrent network compiles to a :class:`CompiledRecurrentNetwork`, with its
+        state at 0; each call gives a fresh state.
+
         Raises:
             NetworkError: unknown activation/aggregation, duplicate or missing nodes,
-                connections to unknown nodes, or a cycle among the needed nodes.
+                connections to unknown nodes, or (feed-forward only) a cycle among the
+                needed nodes.
         """
         return _compile(self)
 
@@ -217,6 +239,11 @@ class CompiledNetwork:
     link_start: np.ndarray  # (n_eval + 1,) int64
     link_source: np.ndarray  # (n_links,) int64 slots
     link_weight: np.ndarray  # (n_links,)
+    #: Whether activations carry state (:class:`CompiledRecurrentNetwork`).
+    recurrent: ClassVar[bool] = False
+
+    def reset(self) -> None:
+        """Forget the state of earlier activations: nothing to forget in a feed-forward one."""
 
     def activate(self, inputs) -> np.ndarray:
         """Evaluate the network on ``inputs`` (length ``n_inputs``); returns the outputs."""
@@ -265,6 +292,49 @@ class CompiledNetwork:
         )
 
 
+@dataclass(frozen=True)
+class CompiledRecurrentNetwork(CompiledNetwork):
+    """A recurrent network with its state: neat-python's ``RecurrentNetwork`` semantics.
+
+    The same arrays as :class:`CompiledNetwork`, but the nodes are the evaluated ones in
+    no particular order (each reads only the previous activation's values) and may form
+    cycles. The state is two buffers of ``n_slots`` values, 0 at first and after
+    :meth:`reset`; an arbitrator resets it at the start of every episode.
+    """
+
+    recurrent: ClassVar[bool] = True
+
+    def __post_init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        """Set every value to 0, as at the start of an episode."""
+        object.__setattr__(self, "_buffers", ([0.0] * self.n_slots, [0.0] * self.n_slots))
+
+    def activate(self, inputs) -> np.ndarray:
+        """One step: inputs set, every node from the previous step's values; the outputs.
+
+        Args:
+            inputs: ``(n_inputs,)`` this control cycle's readings.
+
+        Returns:
+            ``(n_outputs,)`` the output nodes' new values.
+        """
+        if len(inputs) != self.n_inputs:
+            raise ValueError(f"expected {self.n_inputs} inputs, got {len(inputs)}")
+        previous, current = self._buffers
+        values = [float(v) for v in inputs]
+        previous[: self.n_inputs] = values
+        current[: self.n_inputs] = values
+        activations = list(ACTIVATIONS.values())
+        aggregations = list(AGGREGATIONS.values())
+        for slot, bias, response, activation, aggregation, links in self._plan:
+            s = aggregations[aggregation]([previous[source] * weight for source, weight in links])
+            current[slot] = activations[activation](bias + response * s)
+        object.__setattr__(self, "_buffers", (current, previous))
+        return np.array(current[self.n_inputs : self.n_inputs + self.n_outputs])
+
+
 def _num(value, what: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise NetworkError(f"{what} must be a finite number, got {value!r}")
@@ -278,8 +348,12 @@ def _int(value, what: str) -> int:
 
 
 def _bool(value) -> bool:
+    return _flag(value, "connections.enabled")
+
+
+def _flag(value, what: str) -> bool:
     if not isinstance(value, bool):
-        raise NetworkError(f"connections.enabled must be true or false, got {value!r}")
+        raise NetworkError(f"{what} must be true or false, got {value!r}")
     return value
 
 
@@ -330,6 +404,14 @@ def _compile(spec: NetworkSpec) -> CompiledNetwork:
     enabled = [c for c in spec.connections if c.enabled]
     edges = [(c.source, c.target) for c in enabled]
     needed = _needed_nodes(input_set, outputs, edges)
+    if spec.recurrent:
+        # Every node reads the previous step's values, so any order gives the same values;
+        # a needed node without an enabled incoming connection is never evaluated and stays
+        # at 0, as in neat-python's RecurrentNetwork.
+        targets = {b for _, b in edges}
+        order = sorted(n for n in needed if n in targets)
+        idle = sorted(n for n in needed if n not in targets)
+        return _arrays(spec, nodes, inputs, outputs, order, idle, enabled, needed)
 
     # Topological order of the needed nodes (Kahn), ready nodes by key for determinism:
     # in a DAG every order gives the same values.
@@ -341,10 +423,15 @@ def _compile(spec: NetworkSpec) -> CompiledNetwork:
             raise NetworkError("the network has a cycle; only feed-forward networks run here")
         order.extend(ready)
         done.update(ready)
+    return _arrays(spec, nodes, inputs, outputs, order, [], enabled, needed)
 
+
+def _arrays(spec, nodes, inputs, outputs, order, idle, enabled, needed) -> CompiledNetwork:
+    """The flat arrays of the nodes ``order`` (evaluated) and ``idle`` (slots only)."""
+    input_set = set(inputs)
     slots = {k: i for i, k in enumerate(inputs)}
     slots.update({k: len(inputs) + i for i, k in enumerate(outputs)})
-    for k in order:
+    for k in [*order, *idle]:
         slots.setdefault(k, len(slots))
     link_start, link_source, link_weight = [0], [], []
     for k in order:
@@ -354,7 +441,8 @@ def _compile(spec: NetworkSpec) -> CompiledNetwork:
                 link_source.append(slots[c.source])
                 link_weight.append(c.weight)
         link_start.append(len(link_source))
-    return CompiledNetwork(
+    kind = CompiledRecurrentNetwork if spec.recurrent else CompiledNetwork
+    return kind(
         n_inputs=len(inputs),
         n_outputs=len(outputs),
         n_slots=len(slots),

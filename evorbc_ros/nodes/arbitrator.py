@@ -116,6 +116,12 @@ class ArbitratorNode(Node):
                 ) from None
         for w in self.controller.warnings:
             self.get_logger().warning(w)
+        # The node starts with its episode (the bridge sends the first state once the graph
+        # is connected, in lockstep and real time), so a recurrent network starts from 0
+        # there, as offline; a restarted node starts from 0 again, mid-episode.
+        self.controller.reset()
+        if self.controller.recurrent:
+            self.get_logger().info("recurrent network: its state starts at 0")
         spec = self.controller.spec
         layout = spec.sensors
         n_rf = len(layout.rangefinders.angles) if layout.rangefinders else 0

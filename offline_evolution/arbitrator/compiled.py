@@ -2,7 +2,9 @@
 
 :func:`pack_networks` concatenates :class:`~evorbc_ros.network.CompiledNetwork` arrays of a
 whole generation so that one numba kernel can run all genomes; :func:`activate` evaluates
-network ``g`` of a pack. The activation and aggregation codes follow
+feed-forward network ``g`` of a pack, :func:`activate_recurrent` one step of recurrent
+network ``g`` with its two value buffers (neat-python's ``RecurrentNetwork`` semantics,
+docs/design.md section 8). The activation and aggregation codes follow
 :data:`evorbc_ros.network.ACTIVATIONS` and :data:`~evorbc_ros.network.AGGREGATIONS`.
 """
 
@@ -58,6 +60,7 @@ class NetworkPack(NamedTuple):
     link_source: np.ndarray  # int64, slot within the network
     link_weight: np.ndarray
     n_slots: np.ndarray  # (n,) int64
+    recurrent: np.ndarray  # (n,) bool: network g keeps state (activate_recurrent)
     n_inputs: int
     n_outputs: int
 
@@ -87,6 +90,7 @@ def pack_networks(networks: Sequence[CompiledNetwork | NetworkSpec]) -> NetworkP
         link_source=np.concatenate([n.link_source for n in nets]).astype(np.int64),
         link_weight=np.concatenate([n.link_weight for n in nets]),
         n_slots=np.array([n.n_slots for n in nets], dtype=np.int64),
+        recurrent=np.array([n.recurrent for n in nets], dtype=np.bool_),
         n_inputs=n_in,
         n_outputs=n_out,
     )
@@ -208,9 +212,53 @@ def activate(g, inputs, values, out, net):
         out[o] = values[n_in + o]
 
 
+@nb.njit(cache=True)
+def activate_recurrent(g, inputs, buffers, p, out, net):
+    """One step of recurrent network ``g`` of ``net``: read ``buffers[p]``, write the other.
+
+    ``buffers`` is ``(2, >= n_slots)``, all 0 at the start of an episode; the caller
+    alternates ``p`` (0, 1, 0, ...). The inputs go into both rows, then every evaluated
+    node computes from row ``p`` (the previous step's values) into row ``1 - p``, so a
+    signal crosses one connection per step (neat-python's ``RecurrentNetwork``).
+    """
+    node_start, node_slot, bias, response = net.node_start, net.node_slot, net.bias, net.response
+    activation, aggregation = net.activation, net.aggregation
+    link_start, link_source, link_weight = net.link_start, net.link_source, net.link_weight
+    previous = buffers[p]
+    current = buffers[1 - p]
+    n_in = inputs.shape[0]
+    for i in range(n_in):
+        previous[i] = inputs[i]
+        current[i] = inputs[i]
+    for k in range(node_start[g], node_start[g + 1]):
+        s = _aggregate(
+            aggregation[k], previous, link_source, link_weight, link_start[k], link_start[k + 1]
+        )
+        current[node_slot[k]] = activation_function(activation[k], bias[k] + response[k] * s)
+    for o in range(out.shape[0]):
+        out[o] = current[n_in + o]
+
+
 def activate_packed(pack: NetworkPack, g: int, inputs) -> np.ndarray:
-    """Evaluate network ``g`` of ``pack`` from Python (tests and tools)."""
+    """Evaluate feed-forward network ``g`` of ``pack`` from Python (tests and tools)."""
     values = np.zeros(int(pack.n_slots.max()))
     out = np.zeros(pack.n_outputs)
     activate(g, np.asarray(inputs, dtype=np.float64), values, out, pack)
+    return out
+
+
+def activate_packed_sequence(pack: NetworkPack, g: int, inputs) -> np.ndarray:
+    """Network ``g`` of ``pack`` over ``inputs (T, n_inputs)``, from a zero state.
+
+    Returns ``(T, n_outputs)``. Recurrent networks carry their state from row to row;
+    feed-forward ones do not (tests and tools).
+    """
+    rows = np.asarray(inputs, dtype=np.float64)
+    buffers = np.zeros((2, int(pack.n_slots.max())))
+    out = np.zeros((rows.shape[0], pack.n_outputs))
+    for t, x in enumerate(rows):
+        if pack.recurrent[g]:
+            activate_recurrent(g, x, buffers, t % 2, out[t], pack)
+        else:
+            activate(g, x, buffers[0], out[t], pack)
     return out

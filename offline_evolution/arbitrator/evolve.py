@@ -137,7 +137,11 @@ class EvolutionResult:
 
 
 def network_spec(genome, config: neat.Config) -> NetworkSpec:
-    """A neat-python genome as a :class:`NetworkSpec` (genes kept in their order)."""
+    """A neat-python genome as a :class:`NetworkSpec` (genes kept in their order).
+
+    The network is recurrent when the settings say ``feed_forward = False``: neat-python
+    then evolves genomes with cycles, run as its ``RecurrentNetwork`` runs them.
+    """
     gc = config.genome_config
     return NetworkSpec(
         input_keys=tuple(gc.input_keys),
@@ -150,6 +154,7 @@ def network_spec(genome, config: neat.Config) -> NetworkSpec:
             ConnectionSpec(k[0], k[1], float(c.weight), bool(c.enabled))
             for k, c in genome.connections.items()
         ),
+        recurrent=not gc.feed_forward,
     )
 
 

@@ -84,9 +84,9 @@ def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int)
     finally:
         os.unlink(tmp)
     _check_values(config, parser, source)
+    # feed_forward = False evolves recurrent networks, which every evaluator runs with
+    # neat-python's RecurrentNetwork semantics (docs/design.md section 8).
     g = config.genome_config
-    if not g.feed_forward:
-        raise ConfigError(f"{source}: feed_forward must be True (arbitrators are feed-forward)")
     for option, known, what in (
         (g.activation_options, ACTIVATIONS, "activation"),
         (g.aggregation_options, AGGREGATIONS, "aggregation"),

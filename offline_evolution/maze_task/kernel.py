@@ -13,7 +13,9 @@ no primitive, as onboard (:func:`evorbc_ros.mapping.choose_primitive`, the execu
 message): zero wheel speed with the steering held at its last command (4WS), a zero twist
 (differential drive).
 
-Episodes are independent, so results do not depend on the number of threads.
+Episodes are independent, so results do not depend on the number of threads. A recurrent
+network (docs/design.md section 8) keeps its state in its episode's own two value buffers,
+carried from cycle to cycle and 0 at the start of the episode.
 
 A perturbed world (docs/design.md section 21, :mod:`~offline_evolution.maze_task.perturbation`)
 scales the commanded wheel speed, delays commands by whole cycles, adds noise to the
@@ -30,7 +32,7 @@ import numba as nb
 import numpy as np
 
 from evorbc_ros import mapping as onboard_mapping
-from offline_evolution.arbitrator.compiled import activate
+from offline_evolution.arbitrator.compiled import activate, activate_recurrent
 from sim_bridge.four_ws_motion import HEADING, STATE_SIZE, X, Y
 from sim_bridge.geometry import grid_candidates
 from sim_bridge.kinematics import halt, step_model
@@ -67,6 +69,21 @@ def _perturb_readings(inputs, n_rangefinders, noise_sd, dropout, key, cycle):
             u2 = _hash_uniform(key, cycle, k, 2)
             normal = math.sqrt(-2.0 * math.log(1.0 - u1)) * math.cos(2.0 * math.pi * u2)
             inputs[k] = min(max(inputs[k] + noise_sd * normal, 0.0), 1.0)
+
+
+@nb.njit(cache=True)
+def _same_state(buffers, n):
+    """Whether a recurrent network's two buffers hold the same bits in slots ``0..n-1``.
+
+    Then the next step, from the same inputs, writes the same values again. The sign of
+    a zero counts (it can reach an output through ``identity``); NaN never equals itself.
+    """
+    for k in range(n):
+        a = buffers[0, k]
+        b = buffers[1, k]
+        if a != b or math.copysign(1.0, a) != math.copysign(1.0, b):
+            return False
+    return True
 
 
 @nb.njit(cache=True)
@@ -148,6 +165,7 @@ def run_episodes(
     state = np.zeros((n_ep, STATE_SIZE))
     max_slots = net.n_slots.max()
     n_outputs = net.n_outputs
+    net_recurrent, net_slots = net.recurrent, net.n_slots
     # Fields the loop reads every cycle, as locals: numba does not hoist NamedTuple loads.
     boxes, targets, target_radius = world.boxes, world.targets, world.target_radius
     mode, map_kind, map_params = controller.mode, controller.map_kind, controller.map_params
@@ -167,6 +185,9 @@ def run_episodes(
         state[e, HEADING] = start[e, 2]
         inputs = np.empty(sensors.n_inputs)
         values = np.empty(max_slots)
+        # A recurrent network's state (activate_recurrent): 0 at the start of the episode.
+        recurrent = net_recurrent[g]
+        buffers = np.zeros((2, max_slots if recurrent else 1))
         out = np.empty(n_outputs)
         # 4WS: (speed m/s, 4 steering angles rad); a stop keeps the last angles, as the
         # executor does, which start at 0. Differential drive: (v m/s, omega rad/s).
@@ -192,7 +213,10 @@ def run_episodes(
             read_sensors(x, y, h, tx, ty, sensors, boxes, cand, inputs)
             if noise_sd > 0.0 or dropout > 0.0:
                 _perturb_readings(inputs, n_rangefinders, noise_sd, dropout, key, t)
-            activate(g, inputs, values, out, net)
+            if recurrent:
+                activate_recurrent(g, inputs, buffers, t % 2, out, net)
+            else:
+                activate(g, inputs, values, out, net)
             choice = -1
             finite = True
             for k in range(n_outputs):
@@ -246,13 +270,17 @@ def run_episodes(
             if not record and not perturbed:
                 # A fixed point: the whole state (pose, speed, wheel angles) came back
                 # unchanged, so every later cycle reads the same sensors, gets the same
-                # outputs from the (stateless, feed-forward) network and makes the same
-                # step. The episode's outcome is already known: stop here.
+                # outputs from the network and makes the same step. A feed-forward network
+                # is stateless; a recurrent one must also have written the values it read
+                # (both buffers equal), so its next step repeats this one. The episode's
+                # outcome is already known: stop here.
                 same = True
                 for k in range(STATE_SIZE):
                     if state[e, k] != before[k]:
                         same = False
                         break
+                if same and recurrent:
+                    same = _same_state(buffers, net_slots[g])
                 if same:
                     break
         final_distance[e] = dist

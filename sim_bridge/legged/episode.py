@@ -174,6 +174,7 @@ class EpisodeRunner:
         """
         maze, sim = self.sims.get(maze_index)  # a task maze's index or a generated maze
         sim.reset(*start)
+        # A fresh compile per episode: a recurrent network's state starts at 0 here.
         net = network.compile()
         chooser = self.chooser(controller)
         tx, ty = maze.target
