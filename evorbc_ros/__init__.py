@@ -21,7 +21,8 @@ angles in rad, behaviours in the primitive's start frame, x forward and y left):
   point (m), paper eq. 7-9; :class:`PrimitiveLookup`: that point -> the nearest
   primitive, in O(1); :func:`choose_primitive` does both (:data:`NO_PRIMITIVE` if the
   outputs are not finite).
-* :class:`NetworkSpec`: a feed-forward network as plain data; ``compile().activate``.
+* :class:`NetworkSpec`: a feed-forward or recurrent network as plain data;
+  ``compile().activate`` (and ``reset()`` between episodes).
 * :class:`SensorLayout`: the arbitrator's inputs in order (rangefinders, goal sectors,
   goal bearing), ``n_inputs`` of them.
 * :class:`ConfigError`: a settings file or value that is not valid (one line naming it).
