@@ -24,7 +24,8 @@ def main() -> None:
             if heldr.exists()
             else ""
         )
-        arb = json.loads((HERE / f"{stem}.arbitrator.json").read_text())["evolution"]
+        data = json.loads((HERE / f"{stem}.arbitrator.json").read_text())
+        arb = data["evolution"]
         training = arb["task"].get("training")
         what = "none (paper protocol)"
         if training:
@@ -37,6 +38,8 @@ def main() -> None:
         sensors = Path(arb["task"]["sensors"]).stem
         if sensors != "4ws":
             what += f", sensors {sensors}"
+        if data["network"].get("recurrent"):
+            what += ", recurrent"
         if arb["task"]["episode_time"] != 120.0:
             what += f", {arb['task']['episode_time']:g} s episodes"
         seconds = statistics.median(g["seconds"] for g in arb["history"])
