@@ -224,3 +224,56 @@ def test_bad_parameters_stop_a_node_at_start_up(ros, cls, params, needle):
 def test_a_whole_number_is_accepted_for_a_real_parameter(ros):
     node = ros.make(PrimitiveExecutorNode, robot="hexapod", trajectory_rate=100, period=1)
     assert node.logic.dt == pytest.approx(0.01) and node.period == 1.0
+
+
+def clock_network(n_inputs: int):
+    """A recurrent EvoRBC network whose output m1 counts cycles: output 0 adds 0.05 a cycle
+    to itself (a clamped self-loop), output 1 follows the first rangefinder; so the same
+    readings give a different mapping point every cycle until a reset."""
+    from evorbc_ros.network import ConnectionSpec, NetworkSpec, NodeSpec
+
+    nodes = (NodeSpec(0, 0.05, 1.0, "clamped", "sum"), NodeSpec(1, 0.0, 1.0, "sigmoid", "sum"))
+    connections = (ConnectionSpec(0, 0, 1.0), ConnectionSpec(-1, 1, 1.0))
+    inputs = tuple(-i - 1 for i in range(n_inputs))
+    return NetworkSpec(inputs, (0, 1), nodes, connections, recurrent=True)
+
+
+def test_the_reset_service_sets_a_recurrent_arbitrators_state_back_to_zero(
+    ros, tmp_path, small_repertoire
+):
+    from std_srvs.srv import Empty
+
+    arb = ArbitratorFile(
+        "evorbc",
+        "4ws-5",
+        clock_network(LAYOUT.n_inputs),
+        LAYOUT,
+        "polar",
+        {"fingerprint": small_repertoire.fingerprint()},
+    )
+    arb_path, rep_path = tmp_path / "a.json", tmp_path / "r.json"
+    arb.save(arb_path)
+    small_repertoire.save(rep_path)
+    ros.make(ArbitratorNode, arbitrator=str(arb_path), repertoire=str(rep_path))
+    diag = ros.listen(Float64MultiArray, "evorbc/mapping")
+    rf = ros.publisher(Float64MultiArray, "evorbc/rangefinders")
+    gs = ros.publisher(Float64MultiArray, "evorbc/goal_sectors")
+    ros.connected(rf)
+    ros.connected(gs)
+    client = ros.helper.create_client(Empty, "/arbitrator/reset")
+    assert ros.spin_until(client.service_is_ready)
+
+    def cycles(n):
+        start = len(diag)
+        for k in range(n):
+            rf.publish(vector_message([0.5] * 6))
+            gs.publish(vector_message([1, 0, 0, 0]))
+            assert ros.spin_until(lambda k=k: len(diag) == start + k + 1)
+        return [d.data[0] for d in diag[start:]]  # m1 of each cycle
+
+    first = cycles(4)
+    assert first == pytest.approx([0.05, 0.10, 0.15, 0.20])  # the state carries over
+    assert cycles(1) == pytest.approx([0.25])
+    future = client.call_async(Empty.Request())
+    assert ros.spin_until(future.done)
+    assert cycles(4) == first  # back to 0: the same readings give the first outputs again

@@ -4,10 +4,11 @@ Subscribes ``evorbc/rangefinders`` and ``evorbc/goal_sectors`` (Float64MultiArra
 both have a new message it publishes the chosen primitive's genes on ``evorbc/primitive``
 (Float64MultiArray, labelled with the parameter names) and, for EvoRBC, the diagnostic
 ``evorbc/mapping`` = ``[m1, m2, x, y, primitive index]``, also appended to ``record_file``
-(JSON lines) if set. By default it runs the arbitrator
-and repertoire shipped with the package, so ``ros2 run evorbc_ros arbitrator`` needs no
-arguments. Bad files, a repertoire/sensor mismatch, or a controller for another robot
-than the ``robot`` parameter stop it at start-up with one line.
+(JSON lines) if set. A recurrent network's state starts at 0 with the node; the service
+``~/reset`` (std_srvs/Empty) sets it back to 0, for a new goal or a new run. By default it
+runs the arbitrator and repertoire shipped with the package, so ``ros2 run evorbc_ros
+arbitrator`` needs no arguments. Bad files, a repertoire/sensor mismatch, or a controller
+for another robot than the ``robot`` parameter stop it at start-up with one line.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import sys
 import numpy as np
 from rclpy.node import Node
 from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Empty
 
 from evorbc_ros.arbitration import Controller, InputGroups
 from evorbc_ros.arbitrator import ArbitratorError
@@ -122,6 +124,7 @@ class ArbitratorNode(Node):
         self.controller.reset()
         if self.controller.recurrent:
             self.get_logger().info("recurrent network: its state starts at 0")
+        self.reset_service = self.create_service(Empty, "~/reset", self.on_reset)
         spec = self.controller.spec
         layout = spec.sensors
         n_rf = len(layout.rangefinders.angles) if layout.rangefinders else 0
@@ -144,6 +147,18 @@ class ArbitratorNode(Node):
                 else ""
             )
         )
+
+    def on_reset(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
+        """``~/reset``: a recurrent network's state back to 0 (as at an episode's start).
+
+        Readings already received for the current cycle are kept: the next choice uses
+        them with the fresh state. A feed-forward network has no state; the call is logged
+        and changes nothing.
+        """
+        self.controller.reset()
+        what = "state set to 0" if self.controller.recurrent else "feed-forward, no state"
+        self.get_logger().info(f"reset: {what}")
+        return response
 
     def on_input(self, topic: str, msg: Float64MultiArray) -> None:
         """Store one input group; choose once all are new.
