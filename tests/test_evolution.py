@@ -286,3 +286,33 @@ def test_hall_of_fame_keeps_the_best_nominal_reachers():
     assert HallOfFame.from_dict(hall.to_dict()).nominal == hall.nominal
     old = {"size": 2, "top": [], "recent": []}  # a checkpoint from before the watch
     assert HallOfFame.from_dict(old).nominal == []
+
+
+def test_an_interrupted_run_resumes_with_another_length(
+    tmp_path, small_neat_file, small_repertoire
+):
+    """Only the end depends on the run's length: a run of 8 generations interrupted after
+    3 and resumed with 10 gives what a straight run of 10 gives; one past generation 3
+    cannot be resumed to stop at 2."""
+    ten = settings(small_neat_file, generations=10, repertoire=small_repertoire)
+    straight = evolve(ten, small_repertoire)
+    ckpt = tmp_path / "run.checkpoint.json"
+    polls = []
+    eight = settings(small_neat_file, generations=8, repertoire=small_repertoire)
+    with pytest.raises(Interrupted):
+        evolve(
+            eight,
+            small_repertoire,
+            checkpoint=ckpt,
+            should_stop=lambda: polls.append(1) or len(polls) == 3,
+        )
+    kept = ckpt.read_text()
+    two = settings(small_neat_file, generations=2, repertoire=small_repertoire)
+    with pytest.raises(
+        CheckpointError,
+        match="the run is past generation 3, so it cannot stop "
+        "at 2; run it with --generations 3 or more",
+    ):
+        evolve(two, small_repertoire, checkpoint=ckpt)
+    assert ckpt.read_text() == kept  # refused, nothing lost
+    same(straight, evolve(ten, small_repertoire, checkpoint=ckpt))

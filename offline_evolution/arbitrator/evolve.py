@@ -70,6 +70,11 @@ SELECTION_ONLY = ("post_samples", "post_rule", "nominal_watch")
 #: Fields that say where an input lies, not what it holds: the NEAT file's contents are
 #: checked by ``neat_sha256``, so a run resumes in another checkout or folder.
 LOCATION_ONLY = ("neat_file",)
+#: The run's length: nothing before the last generation depends on it (the training draws
+#: are seeded by generation, the hall of fame keeps the best and the latest), so an
+#: interrupted run may resume with more generations, or fewer than planned if it has not
+#: passed them, and gives what a run of that length gives (docs/design.md section 13).
+LENGTH_ONLY = ("generations",)
 
 
 @dataclass(frozen=True)
@@ -378,7 +383,7 @@ class Evolution:
             raise CheckpointError(f"{path}: not a usable checkpoint (settings missing)")
         # Selection settings never change the population, and a file's location never
         # changes its contents, so both may change between sessions.
-        ignored = SELECTION_ONLY + LOCATION_ONLY
+        ignored = SELECTION_ONLY + LOCATION_ONLY + LENGTH_ONLY
         saved, now = (
             {k: v for k, v in d.items() if k not in ignored}
             for d in (data["settings"], self.settings.as_dict())
@@ -389,18 +394,22 @@ class Evolution:
         check_same_robot(path, data.get("simulation"), self.simulation)
         try:
             self.population = population_from_dict(require(data, "population", dict), self.config)
-            return self._restore_record(data)
+            return self._restore_record(data, path)
+        except CheckpointError:
+            raise
         except (KeyError, TypeError, ValueError) as e:
             problem = str(e) if isinstance(e, ValueError) else repr(e)
             raise CheckpointError(f"{path}: not a usable checkpoint ({problem})") from None
 
-    def _restore_record(self, data: dict) -> float:
+    def _restore_record(self, data: dict, path) -> float:
         """Restore the best genome, hall of fame and history; the run's elapsed seconds."""
         generation = self.generation
-        if not 0 <= generation <= self.settings.generations:
-            raise ValueError(
-                f"population.generation must be from 0 to the run's "
-                f"{self.settings.generations}, got {generation}"
+        if generation < 0:
+            raise ValueError(f"population.generation must be 0 or more, got {generation}")
+        if generation > self.settings.generations:
+            raise CheckpointError(
+                f"{path}: the run is past generation {generation}, so it cannot stop at "
+                f"{self.settings.generations}; run it with --generations {generation} or more"
             )
         best = require(data, "best", dict, none_ok=generation == 0)
         if best is not None:
