@@ -5,6 +5,7 @@ or a deadline passes.
 """
 
 import contextlib
+import gc
 import time
 
 import pytest
@@ -104,6 +105,12 @@ def ros_with_args(*args):
 
     Set ``ROS_AUTOMATIC_DISCOVERY_RANGE=OFF`` first (the ``ros`` fixture does).
     """
+    # A node whose constructor raised in an earlier test (a start-up error) is never
+    # destroyed explicitly; the exception's traceback keeps it in a reference cycle until
+    # the garbage collector runs. While it lives, rcl sends every log line of a node of the
+    # same name over its /rosout publisher, in its old context, so a new node's start-up
+    # line would never reach this test's /rosout. Collect it first.
+    gc.collect()
     context = rclpy.Context()
     rclpy.init(context=context, args=["--ros-args", *args] if args else None)
     r = Ros(context)
