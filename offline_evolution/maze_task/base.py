@@ -316,12 +316,32 @@ class MazeTaskBase(abc.ABC):
         return eq5_fitness(reached, cycles * self.dt, final, initial, self.settings.episode_time)
 
     def episode_result(
-        self, reached, cycles, final, initial, traces=None, fell=None
+        self, reached, cycles, final, initial, traces=None, fell=None, ends=None
     ) -> EpisodeResult:
-        """An :class:`EpisodeResult` with eq. 5 fitness; ``traces``: ``(pose, choice, outputs)``."""
+        """An :class:`EpisodeResult` with eq. 5 fitness; ``traces``: ``(pose, choice, outputs)``.
+
+        ``ends``: ``(maze (E,) int, start (E, 2), end (E, 2))``, each episode's maze row and
+        its first and last positions (m); with ``training.distance: path`` a missed
+        episode's fitness uses the path lengths from them (``final`` and ``initial`` stay
+        the straight-line distances the result reports).
+        """
         pose, choice, outputs = traces if traces is not None else (None, None, None)
-        fitness = self.fitness(reached, cycles, final, initial)
+        if ends is not None and self.training is not None and self.training.by_path:
+            fitness = self.fitness(reached, cycles, *self._path_lengths(*ends))
+        else:
+            fitness = self.fitness(reached, cycles, final, initial)
         return EpisodeResult(reached, cycles, final, initial, fitness, pose, choice, outputs, fell)
+
+    def _path_lengths(self, maze, start, end) -> tuple[np.ndarray, np.ndarray]:
+        """``(final (E,), initial (E,))`` shortest path lengths (m) to each episode's target."""
+        maze = np.asarray(maze, dtype=np.int64)
+        final, initial = np.empty(len(maze)), np.empty(len(maze))
+        for k in np.unique(maze):
+            rows = maze == k
+            to_go = self.training.path_to_go
+            final[rows] = to_go(self.mazes[k], end[rows, 0], end[rows, 1])
+            initial[rows] = to_go(self.mazes[k], start[rows, 0], start[rows, 1])
+        return final, initial
 
     def describe(self) -> dict | None:
         """No simulated design to record (a kinematic robot); PyBullet tasks override it."""

@@ -154,7 +154,8 @@ def run_episodes(
             may be 1-sized and are not read.
 
     Returns:
-        ``(reached (E,) bool, cycles (E,) int64, final_distance (E,), initial_distance (E,))``;
+        ``(reached (E,) bool, cycles (E,) int64, final_distance (E,), initial_distance (E,),
+        end (E, 2))``: distances in m to the target, ``end`` the last position (x, y in m);
         ``cycles`` is the cycle count when the target was reached, else ``n_cycles``.
     """
     n_ep = genome.shape[0]
@@ -162,6 +163,7 @@ def run_episodes(
     cycles = np.full(n_ep, n_cycles, dtype=np.int64)
     final_distance = np.empty(n_ep)
     initial_distance = np.empty(n_ep)
+    end = np.empty((n_ep, 2))
     state = np.zeros((n_ep, STATE_SIZE))
     max_slots = net.n_slots.max()
     n_outputs = net.n_outputs
@@ -284,9 +286,11 @@ def run_episodes(
                 if same:
                     break
         final_distance[e] = dist
+        end[e, 0] = state[e, X]
+        end[e, 1] = state[e, Y]
         if record:
             last = cycles[e]
             trace_pose[e, last, 0] = state[e, X]
             trace_pose[e, last, 1] = state[e, Y]
             trace_pose[e, last, 2] = state[e, HEADING]
-    return reached, cycles, final_distance, initial_distance
+    return reached, cycles, final_distance, initial_distance, end

@@ -135,7 +135,11 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
         initial = np.array([r["initial_distance"] for r in results])
         fell = np.array([r["fell"] for r in results], dtype=bool)
         traces = _padded_traces(results, self.n_cycles) if record else None
-        return self.episode_result(reached, cycles, final, initial, traces, fell)
+        maze = np.tile(starts[:, 0].astype(np.int64), len(networks))
+        start_xy = np.array([r["start_xy"] for r in results]).reshape(-1, 2)
+        end_xy = np.array([r["end_xy"] for r in results]).reshape(-1, 2)
+        ends = (maze, start_xy, end_xy)
+        return self.episode_result(reached, cycles, final, initial, traces, fell, ends)
 
     def _job_maze(self, column: float):
         """How a job names maze ``column``: by index or, if generated, the maze itself.

@@ -203,7 +203,7 @@ class MazeTask(MazeTaskBase):
         else:
             params, keys = np.ones((1, 4)), np.zeros(1, dtype=np.int64)
         with numba.parallel_chunksize(_CHUNK):
-            reached, cycles, final, initial = run_episodes(
+            reached, cycles, final, initial, end = run_episodes(
                 genome,
                 maze,
                 start,
@@ -222,7 +222,8 @@ class MazeTask(MazeTaskBase):
                 keys,
             )
         traces = (pose, choice, outputs) if record else None
-        return self.episode_result(reached, cycles, final, initial, traces)
+        ends = (maze, start[:, :2], end)
+        return self.episode_result(reached, cycles, final, initial, traces, ends=ends)
 
     # -- the task protocol (offline_evolution.task_protocol) -----------------------
 

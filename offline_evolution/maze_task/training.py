@@ -16,7 +16,12 @@ A maze task whose settings hold a ``training`` mapping trains on the generator's
   task's own mazes plus ``post_mazes`` generated mazes of ``maze_seed`` that no pool holds
   (indices from ``pool`` up): validation mazes, not the held-out set;
 * the held-out set (generator seed :data:`~offline_evolution.mazes.held_out.HELD_OUT_SEED`)
-  is refused: as ``maze_seed``, as the run seed, and as maze files named after it.
+  is refused: as ``maze_seed``, as the run seed, and as maze files named after it;
+* ``distance: path`` scores a missed episode by the shortest path's length to the target
+  (the generator's clearance-aware path search) instead of the straight line, in every
+  training maze and in the post-selection: ``1 - p_final / p_initial``. Eq. 5 as the
+  paper writes it (``euclidean``) rewards closing in across a wall, which a maze's dead
+  ends and baffles turn into traps; the path length does not.
 
 Generated mazes are proven solvable by the generator; a task keeps the last
 :data:`CACHE` of them (and their compiled packs, 4WS), so a pool costs its generation once.
@@ -33,6 +38,7 @@ import numpy as np
 from evorbc_ros.config import ConfigError, build_settings, setting
 from offline_evolution.maze_task.perturbation import NONE, PerturbationSet, load_perturbations
 from offline_evolution.mazes.held_out import HELD_OUT_SEED, is_held_out
+from offline_evolution.mazes.paths import DistanceGrid
 from sim_bridge.maze import Maze
 
 #: Maze indices a fresh draw picks from: with K = 10 mazes over 1000 generations, two
@@ -40,6 +46,10 @@ from sim_bridge.maze import Maze
 FRESH_INDICES = 2**40
 #: Generated mazes a task keeps (a pool larger than this is generated again as it cycles).
 CACHE = 512
+#: Path-distance grids a task keeps (about 0.6 MB each for the 4WS mazes).
+GRID_CACHE = 128
+#: How a missed episode's distance to the target is measured (``training.distance``).
+DISTANCES = ("euclidean", "path")
 #: Name prefix of training mazes (``train1-000042``): never a held-out maze's ``gen21021-``.
 PREFIX = "train"
 
@@ -59,6 +69,9 @@ class TrainingSettings:
     task_mazes: bool = setting(True, doc="also train on the task's mazes")
     perturb: str = setting("none", doc="perturbation set of the training episodes")
     post_mazes: int = setting(10, doc="generated validation mazes in the post-selection", minimum=0)
+    distance: str = setting(
+        "euclidean", doc="a missed episode's distance to the target: euclidean (eq. 5) or path"
+    )
 
     @classmethod
     def from_dict(cls, values, source: str) -> TrainingSettings:
@@ -82,6 +95,10 @@ class TrainingSettings:
                 f"{where}: maze_seed {HELD_OUT_SEED} is the held-out mazes' seed, kept for "
                 "evaluation (docs/design.md section 21); choose another"
             )
+        if s.distance not in DISTANCES:
+            raise ConfigError(
+                f"{where}: distance {s.distance!r}: expected one of {', '.join(DISTANCES)}"
+            )
         try:
             load_perturbations(s.perturb)
         except ConfigError as e:
@@ -98,6 +115,9 @@ class TrainingSettings:
             "task_mazes": self.task_mazes,
             "perturb": self.perturb,
             "post_mazes": self.post_mazes,
+            # Recorded only when set, so that files and checkpoints written before the
+            # setting existed keep their exact settings (a resume compares them).
+            **({"distance": self.distance} if self.distance != "euclidean" else {}),
         }
 
 
@@ -141,6 +161,8 @@ class TrainingMazes:
         self.spec = spec_for_robot(robot)
         self.perturbation: PerturbationSet = load_perturbations(settings.perturb)
         self._cache: OrderedDict[int, Maze] = OrderedDict()
+        #: Path-distance grids by maze name (``distance: path`` only), the last GRID_CACHE.
+        self._grids: OrderedDict[str, DistanceGrid] = OrderedDict()
         #: s spent generating and proving mazes in the last :meth:`mazes` call.
         self.generation_seconds = 0.0
 
@@ -169,19 +191,50 @@ class TrainingMazes:
         for index in map(int, indices):
             maze = self._cache.get(index)
             if maze is None:
-                maze = generate_maze(self.spec, self.settings.maze_seed, index, PREFIX).maze
+                made = generate_maze(self.spec, self.settings.maze_seed, index, PREFIX)
+                maze = made.maze
                 self._cache[index] = maze
                 if len(self._cache) > CACHE:
                     self._cache.popitem(last=False)
+                if self.by_path:
+                    self._keep_grid(maze.name, made.grid)
             else:
                 self._cache.move_to_end(index)
             out.append(maze)
         self.generation_seconds = time.perf_counter() - start
         return out
 
+    @property
+    def by_path(self) -> bool:
+        """True if a missed episode is scored by path length (``distance: path``)."""
+        return self.settings.distance == "path"
+
+    def path_to_go(self, maze: Maze, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Shortest path lengths (m) to ``maze``'s target from points ``x, y (k,)`` in m.
+
+        Generated mazes reuse their proof's field; the task's own mazes (and a generated
+        maze whose grid was dropped) are searched once with the generator's margins.
+        """
+        grid = self._grids.get(maze.name)
+        if grid is None:
+            from offline_evolution.mazes.paths import distance_grid, solve
+
+            field_ = solve(maze, self.spec.cell, self.spec.margin, self.spec.snap)
+            grid = distance_grid(field_)
+            self._keep_grid(maze.name, grid)
+        else:
+            self._grids.move_to_end(maze.name)
+        return grid.at(x, y)
+
+    def _keep_grid(self, name: str, grid: DistanceGrid) -> None:
+        self._grids[name] = grid
+        if len(self._grids) > GRID_CACHE:
+            self._grids.popitem(last=False)
+
 
 __all__ = [
     "CACHE",
+    "DISTANCES",
     "FRESH_INDICES",
     "TrainingMazes",
     "TrainingSettings",

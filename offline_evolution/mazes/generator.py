@@ -44,7 +44,15 @@ import numpy as np
 from evorbc_ros.config import ConfigError
 from sim_bridge.maze import Maze, load_named_maze, maze_from_dict
 
-from .paths import longest_start_path, narrowest_gap, solve, stranded_starts
+from .paths import (
+    DistanceGrid,
+    Field,
+    distance_grid,
+    longest_start_path,
+    narrowest_gap,
+    solve,
+    stranded_starts,
+)
 
 #: Obstacle kinds, and how often each is drawn.
 KINDS = ("baffle", "gap", "diagonal", "posts", "block", "dead_end", "chamber")
@@ -149,6 +157,9 @@ class GeneratedMaze:
     longest_path: float  # m, the longest shortest path from a start cell
     narrowest_gap: float  # m, on the widest route
     tries: int = 1  # draws it took
+    #: Path lengths to the target from anywhere (the proof's field, kept compact): what
+    #: path-distance training fitness reads (docs/design.md section 22).
+    grid: DistanceGrid | None = field(default=None, compare=False, repr=False)
 
     def as_dict(self) -> dict:
         """Plain-data summary (CLI output)."""
@@ -352,9 +363,11 @@ def generate_maze(spec: MazeSpec, seed: int, index: int, prefix: str = "gen") ->
             maze = maze_from_dict(data, name)
         except ConfigError:
             continue  # a target or start inside a wall: draw again
-        proof = prove(maze, spec)
+        proof = _proof(maze, spec)
         if proof is not None:
-            return GeneratedMaze(maze, tuple(draft.kinds), mode, *proof, tries=attempt)
+            longest, gap, field_ = proof
+            grid = distance_grid(field_)
+            return GeneratedMaze(maze, tuple(draft.kinds), mode, longest, gap, attempt, grid)
     raise RuntimeError(f"no solvable maze for {spec.robot} in {MAX_TRIES} draws (seed {seed})")
 
 
@@ -365,6 +378,12 @@ def prove(maze: Maze, spec: MazeSpec) -> tuple[float, float] | None:
     ``spec.margin`` from the walls, within ``spec.path_limit``, and the widest route's
     narrowest gap is at least the design's narrowest less two grid cells.
     """
+    proof = _proof(maze, spec)
+    return None if proof is None else proof[:2]
+
+
+def _proof(maze: Maze, spec: MazeSpec) -> tuple[float, float, Field] | None:
+    """:func:`prove`'s figures and the path field it searched, or None."""
     field_ = solve(maze, spec.cell, spec.margin, spec.snap)
     if stranded_starts(maze, field_, spec.robot_radius):
         return None
@@ -374,7 +393,7 @@ def prove(maze: Maze, spec: MazeSpec) -> tuple[float, float] | None:
     gap = narrowest_gap(maze, spec.cell)
     if gap < spec.narrow_gap[0] - 2 * spec.cell:
         return None
-    return longest, gap
+    return longest, gap, field_
 
 
 def generate_mazes(robot: str, count: int, seed: int, prefix: str = "gen") -> list[GeneratedMaze]:

@@ -94,6 +94,45 @@ class Field:
         return np.column_stack([self.xs[i], self.ys[j]])
 
 
+@dataclass(frozen=True)
+class DistanceGrid:
+    """Shortest path length to the target from anywhere in a maze, on a grid (float32).
+
+    Built by :func:`distance_grid` from a :class:`Field`: a free cell (or one within ``snap``
+    of one) holds its geodesic distance; any other cell (a robot pressed into a corner
+    narrower than the margin) the distance of the nearest such cell plus the straight step
+    to it, so every point of the maze has a finite, continuous-enough value. Cells cut off
+    from the target (an enclosed pocket) hold the nearest reachable cell's value too.
+    """
+
+    x0: float  # m, x of cell column 0's centre
+    y0: float  # m, y of cell row 0's centre
+    cell: float  # m, grid cell side
+    values: np.ndarray  # (ny, nx) float32, m
+
+    def at(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Path lengths (m, float64) to the target from points ``x, y (k,)`` in m."""
+        ny, nx = self.values.shape
+        i = np.clip(np.rint((np.asarray(x) - self.x0) / self.cell).astype(np.int64), 0, nx - 1)
+        j = np.clip(np.rint((np.asarray(y) - self.y0) / self.cell).astype(np.int64), 0, ny - 1)
+        return self.values[j, i].astype(np.float64)
+
+
+def distance_grid(field: Field) -> DistanceGrid:
+    """The :class:`DistanceGrid` of ``field`` (its :meth:`Field.to_go`, completed)."""
+    from scipy.ndimage import distance_transform_edt
+
+    values = field.snapped
+    known = np.isfinite(values)
+    cell = float(field.xs[1] - field.xs[0])
+    if not known.any():
+        raise ValueError("the target cannot be reached from any cell")
+    if not known.all():
+        step, (jj, ii) = distance_transform_edt(~known, return_indices=True)
+        values = values[jj, ii] + step * cell
+    return DistanceGrid(float(field.xs[0]), float(field.ys[0]), cell, values.astype(np.float32))
+
+
 def clearance_grid(maze: Maze, cell: float = 0.01) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cell centres ``xs (nx,)``, ``ys (ny,)`` and the clearance ``(ny, nx)`` in m."""
     x0, y0, x1, y1 = maze.bounds()

@@ -167,7 +167,8 @@ class EpisodeRunner:
         (:meth:`~offline_evolution.maze_task.perturbation.WorldDraw.row`), or None.
 
         Returns:
-            ``{"reached", "fell", "cycles", "final_distance", "initial_distance"}`` and,
+            ``{"reached", "fell", "cycles", "final_distance", "initial_distance", "start_xy",
+            "end_xy"}`` (distances and positions in m, the body's first and last x, y) and,
             with ``record``, ``"pose" (cycles + 1, 3)``, ``"choice" (cycles,)`` and
             ``"outputs" (cycles, n_outputs)``.
 
@@ -183,6 +184,7 @@ class EpisodeRunner:
         base = sim.base_pose()
         x, y, heading, _ = sim.pose(base)
         initial = math.hypot(x - tx, y - ty)
+        start_xy = (x, y)
         distance = initial
         reached = fell = False
         poses, choices, outputs = [(x, y, heading)], [], []
@@ -231,6 +233,8 @@ class EpisodeRunner:
             "cycles": cycles,
             "final_distance": distance,
             "initial_distance": initial,
+            "start_xy": start_xy,
+            "end_xy": (x, y),
         }
         if record:
             result["pose"] = np.array(poses)
