@@ -9,7 +9,9 @@ Prints, per generation:
   whether the compiled kernel compiled again (it must not: the pack's types never change);
 * the **cost of a generation** of arbitrator evolution (4ws-5, the shipped NEAT settings,
   population 150, 120 s episodes) on the paper protocol (the five paper mazes, one start
-  each) and with K generated mazes more, fresh and from a pool: the median over
+  each) and with K generated mazes more, fresh, fresh with path-length fitness
+  (``distance: path``: each maze's path-distance grid and a lookup per episode), and from
+  a pool: the median over
   ``--generations`` generations of the same seeded run, the first (compilation) left out.
 
 Run: ``.venv/bin/python bench/bench_training_mazes.py [--generations 6] [--k 5]``.
@@ -41,19 +43,21 @@ PAPER = {
 }
 
 
-def task_dict(k: int, pool: int) -> dict:
+def task_dict(k: int, pool: int, distance: str = "euclidean") -> dict:
     """The paper's task plus K generated mazes (fresh if ``pool`` is 0), one start each."""
     if k == 0:
         return dict(PAPER)
-    return {**PAPER, "training": {"generated": k, "pool": pool, "maze_seed": 1}}
+    training = {"generated": k, "pool": pool, "maze_seed": 1, "distance": distance}
+    return {**PAPER, "training": training}
 
 
-def setup_costs(k: int, pool: int, draws: int) -> dict:
+def setup_costs(k: int, pool: int, draws: int, distance: str = "euclidean") -> dict:
     """Median s per generation: maze generation + proof, and kernel upload (repack).
 
     With a pool, every pool maze is made first (once per run), so draws are cache hits.
     """
-    task = MazeTask(MazeTaskSettings.from_dict(task_dict(k, pool), "bench"), "4ws-5")
+    settings = MazeTaskSettings.from_dict(task_dict(k, pool, distance), "bench")
+    task = MazeTask(settings, "4ws-5")
     task.start_training("4ws-5", seed=1)
     t = task.training
     if pool:
@@ -70,7 +74,9 @@ def setup_costs(k: int, pool: int, draws: int) -> dict:
     return {"make": statistics.median(make), "upload": statistics.median(upload)}
 
 
-def generation_seconds(k: int, pool: int, generations: int, repertoire) -> tuple[float, float]:
+def generation_seconds(
+    k: int, pool: int, generations: int, repertoire, distance: str = "euclidean"
+) -> tuple[float, float]:
     """Median ``(s per generation, s of its episodes)``, the first generation left out."""
     neat = ROOT / "config" / "neat" / "4ws.ini"
     settings = EvolutionSettings(
@@ -80,7 +86,7 @@ def generation_seconds(k: int, pool: int, generations: int, repertoire) -> tuple
         seed=1,
         neat_file=str(neat),
         neat_sha256=file_sha256(neat),
-        task=task_dict(k, pool),
+        task=task_dict(k, pool, distance),
         mapping="polar",
         repertoire_fingerprint=repertoire.fingerprint(),
     )
@@ -110,8 +116,12 @@ def main() -> int:
         f"\nmaze setup per generation, K = {args.k} generated 4ws-5 mazes (median of "
         f"{args.draws} draws):"
     )
-    for label, pool in (("fresh", 0), (f"pool {args.pool}, made before", args.pool)):
-        cost = setup_costs(args.k, pool, args.draws)
+    for label, pool, distance in (
+        ("fresh", 0, "euclidean"),
+        ("fresh, path fitness", 0, "path"),
+        (f"pool {args.pool}, made before", args.pool, "euclidean"),
+    ):
+        cost = setup_costs(args.k, pool, args.draws, distance)
         print(
             f"  {label:28s} generation + proof {cost['make'] * 1e3:8.1f} ms   "
             f"kernel upload {cost['upload'] * 1e3:6.2f} ms"
@@ -121,13 +131,14 @@ def main() -> int:
         f"median of {args.generations} generations after the first:"
     )
     base = None
-    for label, k, pool in (
-        ("paper protocol (5 mazes)", 0, 0),
-        (f"+ {args.k} fresh generated mazes", args.k, 0),
-        (f"+ {args.k} from a pool of {args.pool}", args.k, args.pool),
+    for label, k, pool, distance in (
+        ("paper protocol (5 mazes)", 0, 0, "euclidean"),
+        (f"+ {args.k} fresh generated mazes", args.k, 0, "euclidean"),
+        (f"+ {args.k} fresh, path fitness", args.k, 0, "path"),
+        (f"+ {args.k} from a pool of {args.pool}", args.k, args.pool, "euclidean"),
     ):
         before = len(kernel.run_episodes.signatures)
-        total, episodes = generation_seconds(k, pool, args.generations, repertoire)
+        total, episodes = generation_seconds(k, pool, args.generations, repertoire, distance)
         compiled = len(kernel.run_episodes.signatures) - before
         base = base or total
         print(
