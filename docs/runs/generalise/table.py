@@ -35,6 +35,10 @@ def main() -> None:
                 what += ", no paper mazes"
             if training.get("perturb", "none") != "none":
                 what += f", `{training['perturb']}`"
+            if training.get("distance", "euclidean") != "euclidean":
+                what += f", {training['distance']} fitness"
+            if arb["task"]["samples_per_maze"] != 1:
+                what += f", {arb['task']['samples_per_maze']} starts per paper maze"
         sensors = Path(arb["task"]["sensors"]).stem
         if sensors != "4ws":
             what += f", sensors {sensors}"
