@@ -231,3 +231,46 @@ def test_the_eta_is_not_thrown_by_one_slow_generation(capsys):
     # 107 generations left at 30 s each, the slow one shown as it was but not projected
     assert "300.00 s/gen  eta  53.5 min" in lines[2]
     assert lines[3].endswith("30.00 s/gen  eta  53.0 min")
+
+
+def test_a_kept_checkpoint_continues_to_more_generations(
+    tmp_path, capsys, small_repertoire, small_neat_file, small_task_file
+):
+    """--keep-checkpoint: a finished run of 2 generations goes on to 4 and writes what a
+    straight run of 4 writes."""
+    rep = tmp_path / "r.json"
+    small_repertoire.save(rep)
+    common = ["arbitrator", "--repertoire", rep, "--seed", 2, "--neat-config", small_neat_file]
+    common += ["--task", small_task_file, "--quiet"]
+    ckpt = tmp_path / "run.checkpoint.json"
+    code, _, err = run(
+        capsys,
+        *common,
+        "--generations",
+        2,
+        "--out",
+        tmp_path / "two.json",
+        "--checkpoint",
+        ckpt,
+        "--keep-checkpoint",
+    )
+    assert code == 0, err
+    assert (
+        ckpt.exists() and ArbitratorFile.load(tmp_path / "two.json").evolution["generations"] == 2
+    )
+    code, _, err = run(
+        capsys, *common, "--generations", 4, "--out", tmp_path / "four.json", "--checkpoint", ckpt
+    )
+    assert code == 0, err
+    assert not ckpt.exists()  # without the flag, a finished run's checkpoint goes
+    code, _, err = run(capsys, *common, "--generations", 4, "--out", tmp_path / "straight.json")
+    assert code == 0, err
+    continued = ArbitratorFile.load(tmp_path / "four.json")
+    straight = ArbitratorFile.load(tmp_path / "straight.json")
+    assert continued.network.to_dict() == straight.network.to_dict()
+    strip = [
+        {k: v for k, v in h.items() if "seconds" not in k} for h in continued.evolution["history"]
+    ]
+    assert strip == [
+        {k: v for k, v in h.items() if "seconds" not in k} for h in straight.evolution["history"]
+    ]

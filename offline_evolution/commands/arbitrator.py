@@ -58,6 +58,12 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="discard an existing checkpoint and start from scratch",
     )
+    p.add_argument(
+        "--keep-checkpoint",
+        action="store_true",
+        help="keep the finished run's checkpoint, so that the same command with a larger "
+        "--generations continues it (e.g. look at 300 generations, then go on to 1000)",
+    )
     p.add_argument("--quiet", action="store_true", help="no per-generation lines")
     add_workers_option(p)
 
@@ -262,7 +268,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
                 f"{robot}, seed {args.seed}",
             )
 
-        write_then_discard(checkpoint, write)
+        write_then_discard(checkpoint, write, discard=not args.keep_checkpoint)
     label = "arbitrator" if args.kind == "evorbc" else "standard-NEAT controller"
     post = result.post_evaluation
     print(

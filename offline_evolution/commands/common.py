@@ -152,11 +152,12 @@ def check_distinct(files: dict[str, str | os.PathLike | None]) -> None:
             raise CliError(f"{option} {path} is the same file as {other}; use another file")
 
 
-def write_then_discard(checkpoint: Path, write: Callable[[], None]) -> None:
-    """Write a finished run's files, then delete its checkpoint.
+def write_then_discard(checkpoint: Path, write: Callable[[], None], discard: bool = True) -> None:
+    """Write a finished run's files, then delete its checkpoint (unless not ``discard``).
 
     The run saved its finished state to ``checkpoint``; if writing fails it is kept and
-    the one-line error says so, and the same command then only writes the files.
+    the one-line error says so, and the same command then only writes the files. A kept
+    checkpoint (``--keep-checkpoint``) lets a longer run continue the finished one.
     """
     try:
         write()
@@ -166,7 +167,8 @@ def write_then_discard(checkpoint: Path, write: Callable[[], None]) -> None:
             f"{where}; the finished run is kept in {checkpoint}: run the same command "
             "again to write its files"
         ) from None
-    checkpoint.unlink(missing_ok=True)
+    if discard:
+        checkpoint.unlink(missing_ok=True)
 
 
 def restart_from_scratch(checkpoint: Path, kind: str, what: str) -> None:

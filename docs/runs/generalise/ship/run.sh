@@ -1,29 +1,27 @@
 #!/bin/sh
-# Candidate for the shipped generalising 4ws-5 controller (docs/generalisation.md, issue 21
-# item 5): the shipped generated-maze task (config/tasks/maze-4ws-generated.yaml: the paper
-# mazes plus 10 fresh generated mazes a generation, the 8-sector goal radar) with recurrent
-# networks, 1000 generations, then the held-out evaluation of run.sh's three suites.
-# Re-running the same command resumes from the checkpoint and skips what is done.
-#   usage: sh docs/runs/generalise/ship/run.sh [SEED]   (from the repository's root)
+# A candidate for the shipped generalising 4ws-5 controller (docs/generalisation.md, issue
+# 21 item 5): recurrent networks (config/neat/4ws-recurrent.ini) on a generated-maze task,
+# first 300 generations (written as NAME-seedS-g300.*: the run's screening row, comparable
+# with ../run.sh's), then the same run continued to GENERATIONS (NAME-seedS.*), each
+# evaluated on the three suites of evaluate.sh. Re-running the same command resumes from the
+# checkpoint and skips what is done.
+#   usage: sh docs/runs/generalise/ship/run.sh NAME TASK [SEED] [GENERATIONS]
+#   e.g.   sh docs/runs/generalise/ship/run.sh 4ws-5-path-p3 docs/runs/generalise/ship/task-path-p3.yaml 1 1000
 # (Edit this file only by replacing it, never in place: a running sh reads it as it goes.)
 set -e
-seed=${1:-1}
+name=$1; task=$2; seed=${3:-1}; gens=${4:-1000}
 dir=docs/runs/generalise/ship
-out=$dir/4ws-5-general-seed$seed
-if [ ! -f $out.arbitrator.json ] || [ -f $out.checkpoint.json ]; then
+out=$dir/$name-seed$seed
+evolve() {
   .venv/bin/evorbc-evolve arbitrator --repertoire evorbc_ros/data/4ws-5.repertoire.json \
-    --task config/tasks/maze-4ws-generated.yaml --neat-config config/neat/4ws-recurrent.ini \
-    --seed $seed --generations 1000 --workers 1 --quiet \
-    --out $out.arbitrator.json --checkpoint $out.checkpoint.json
+    --task $task --neat-config config/neat/4ws-recurrent.ini --seed $seed --workers 1 --quiet \
+    --checkpoint $out.checkpoint.json "$@"
+}
+if [ ! -f $out-g300.arbitrator.json ]; then
+  evolve --generations 300 --keep-checkpoint --out $out-g300.arbitrator.json
 fi
-for suite in paper held heldr; do
-  [ -f $out.$suite.json ] && continue
-  case $suite in
-    paper) extra="--perturb none" ;;
-    held) extra="--generated 50 --perturb none" ;;
-    heldr) extra="--generated 50 --perturb realistic" ;;
-  esac
-  .venv/bin/evorbc-evolve evaluate --arbitrator $out.arbitrator.json $extra --starts 20 \
-    --repertoire evorbc_ros/data/4ws-5.repertoire.json --json | .venv/bin/python docs/runs/generalise/summary.py > $out.$suite.tmp
-  mv $out.$suite.tmp $out.$suite.json
-done
+sh $dir/evaluate.sh $out-g300
+if [ ! -f $out.arbitrator.json ] || [ -f $out.checkpoint.json ]; then
+  evolve --generations $gens --out $out.arbitrator.json
+fi
+sh $dir/evaluate.sh $out
