@@ -1,7 +1,7 @@
 #!/bin/sh
 # One legged screening run of docs/generalisation.md: evolve ROBOT's arbitrator on a task of
 # tasks/ with its shipped repertoire, then evaluate it from 20 random starts in its own maze
-# and on 10 held-out mazes (seed 21021) x 5 starts, unperturbed and under `realistic`, with
+# and on the 10 held-out mazes (seed 21021) x 20 starts (issue 21 item 5), unperturbed and under `realistic`, with
 # the episodes it was trained with. Re-running the same command resumes from the checkpoint.
 #   usage: sh docs/runs/generalise/run-legged.sh ROBOT NAME [SEED] [GENERATIONS] [NEAT.ini]
 set -e
@@ -17,9 +17,9 @@ for suite in own held ownr heldr; do
   [ -f $out.$suite.json ] && continue
   case $suite in
     own) extra="--starts 20 --perturb none" ;;
-    held) extra="--generated 10 --starts 5 --perturb none" ;;
+    held) extra="--generated 10 --starts 20 --perturb none" ;;
     ownr) extra="--starts 20 --perturb realistic" ;;
-    heldr) extra="--generated 10 --starts 5 --perturb realistic" ;;
+    heldr) extra="--generated 10 --starts 20 --perturb realistic" ;;
   esac
   .venv/bin/evorbc-evolve evaluate --arbitrator $out.arbitrator.json $extra \
     --repertoire evorbc_ros/data/$robot.repertoire.json --json | .venv/bin/python $dir/summary.py > $out.$suite.tmp
