@@ -132,7 +132,8 @@ class Robot:
             only) when the shipped default is another, e.g. one trained on generated
             mazes; "" means the shipped arbitrator is the paper protocol's. Relative to
             ``evorbc_ros/data`` or absolute, for the shipped repertoire; it needs a
-            shipped controller. The paper check and ``--paper`` use it.
+            shipped controller. ``--paper`` and the tests pinning the paper protocol's
+            figures use it.
         design_check: optional ``f(robot, controller)`` raising ``ConfigError`` when
             ``evorbc-sim`` is given a controller evolved for another design than the
             bridge simulates (the hexapod's geometry, physics and laser).
