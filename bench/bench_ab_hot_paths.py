@@ -12,7 +12,7 @@ hot paths. This script measures, in fresh processes whose imports come from each
 * 4WS episodes: control cycles/s of one arbitrator generation (150 NEAT networks, 5 mazes,
   120 s, the shipped repertoire, EvoRBC polar mapping), the compiled episode kernel;
 * hexapod primitives: evaluations/s of 2 s gaits in PyBullet on one worker;
-* hexapod episodes: control cycles/s of the shipped hexapod controller's 30 s episode on
+* hexapod episodes: control cycles/s of the paper-protocol hexapod controller's 30 s episode on
   one worker.
 
 The trees run in turn, A B B A A B ... (this machine drifts by 20 % from day to day, and
@@ -112,15 +112,15 @@ def four_ws_episodes() -> float:
 
 
 def hexapod_episodes() -> float:
-    """Control cycles/s of the shipped hexapod controller's episode, one worker."""
+    """Control cycles/s of the paper-protocol hexapod controller's episode, one worker."""
     from evorbc_ros.arbitrator import ArbitratorFile
-    from evorbc_ros.defaults import default_arbitrator, default_repertoire
+    from evorbc_ros.defaults import default_repertoire, paper_arbitrator
     from evorbc_ros.repertoire import Repertoire
     from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
     from offline_evolution.maze_task.task import MazeTaskSettings
 
-    arb = ArbitratorFile.load(default_arbitrator("hexapod"))
-    settings = MazeTaskSettings.from_dict(arb.evolution["task"], "the shipped arbitrator")
+    arb = ArbitratorFile.load(paper_arbitrator("hexapod"))
+    settings = MazeTaskSettings.from_dict(arb.evolution["task"], "the paper arbitrator")
     task = HexapodMazeTask(settings, workers=1)
     try:
         rep = Repertoire.load(default_repertoire("hexapod"))

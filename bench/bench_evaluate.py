@@ -1,6 +1,7 @@
 """Benchmark: throughput of held-out evaluation (``evorbc-evolve evaluate``), episodes per second.
 
-Runs the shipped controllers through :func:`offline_evolution.maze_task.evaluation.evaluate_suite`
+Runs the paper-protocol controllers (``evorbc_ros.defaults.paper_arbitrator``) through
+:func:`offline_evolution.maze_task.evaluation.evaluate_suite`
 (the command's work: the episodes, recorded, then the stall and collision measures) and
 prints episodes per second, with the episodes alone and the measures apart:
 
@@ -29,7 +30,7 @@ from pathlib import Path
 from bench_hexapod_repertoire import machine
 
 from evorbc_ros.arbitrator import ArbitratorFile
-from evorbc_ros.defaults import default_arbitrator, default_repertoire
+from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.commands.evaluate import HELD_OUT_SEED
 from offline_evolution.maze_task import evaluation
@@ -75,7 +76,8 @@ def report(label: str, n: int, total: float, episodes: float, cycles: int) -> No
 
 
 def four_ws(starts: int, generated: int) -> None:
-    arb = ArbitratorFile.load(default_arbitrator("4ws-5"))
+    # The paper-protocol controllers (their sensor layouts below): the recorded figures'.
+    arb = ArbitratorFile.load(paper_arbitrator("4ws-5"))
     repertoire = Repertoire.load(default_repertoire("4ws-5"))
     realistic = load_perturbations("realistic")
     with tempfile.TemporaryDirectory() as tmp:
@@ -99,7 +101,7 @@ def four_ws(starts: int, generated: int) -> None:
 
 
 def hexapod(starts: int) -> None:
-    arb = ArbitratorFile.load(default_arbitrator("hexapod"))
+    arb = ArbitratorFile.load(paper_arbitrator("hexapod"))
     repertoire = Repertoire.load(default_repertoire("hexapod"))
     task = make_task(MazeTaskSettings(("hexapod",), 30.0, 1, "sensors/hexapod.yaml"), "hexapod")
     try:
@@ -131,8 +133,8 @@ def main() -> None:
     four_ws(args.starts, args.generated)
     hexapod(args.hexapod_starts)
     for cli in (
-        ["evaluate", "--starts", str(args.starts)],
-        ["evaluate", "--generated", str(args.generated), "--starts", str(args.starts)],
+        ["evaluate", "--paper", "--starts", str(args.starts)],
+        ["evaluate", "--paper", "--generated", str(args.generated), "--starts", str(args.starts)],
     ):
         print(f"evorbc-evolve {' '.join(cli)}: {command(cli):.1f} s in a fresh process")
     print(f"load average at the end {os.getloadavg()[0]:.1f}")

@@ -11,7 +11,8 @@ A real 2D lidar sends 10-40 scans/s of 360-1440 beams; at 40 scans/s a core has 
 per scan.
 
 With ``--graph``: the dropout tolerance through the ROS 2 graph. The lockstep graph runs
-the shipped 4ws-5 controller in the ``obstacle`` maze with a relay between the bridge's
+the paper-protocol 4ws-5 controller (``paper_arbitrator``, whose figures are recorded) in
+the ``obstacle`` maze with a relay between the bridge's
 ``scan`` and the laser node that knocks out 5 % or 20 % of the beams (independently,
 seeded) and a fixed 10-deg sector; it prints the share of scans that gave readings and
 whether the target was reached. Start it in a network namespace of its own if other ROS 2
@@ -86,13 +87,17 @@ def graph_dropouts() -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
     from dropout_graph import DEAD_SECTOR, DropoutRun
 
+    from evorbc_ros.defaults import paper_arbitrator
+
     print(f"dead sector {DEAD_SECTOR} deg in every run; lockstep, obstacle maze, 4ws-5")
     print(f"{'dropout':>8} {'seed':>5} {'scans':>6} {'used':>6} {'share':>7}  outcome")
     domain = 180
     for dropout in (0.0, 0.05, 0.2):
         for seed in (1, 2, 3) if dropout else (1,):
             with tempfile.TemporaryDirectory() as tmp:
-                run = DropoutRun(Path(tmp), domain, "obstacle", dropout, DEAD_SECTOR, seed)
+                run = DropoutRun(
+                    Path(tmp), domain, "obstacle", dropout, DEAD_SECTOR, seed, paper_arbitrator()
+                )
                 got = run.finish(timeout=300)
                 c = run.counts()
             domain += 1

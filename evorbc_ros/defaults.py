@@ -5,6 +5,12 @@ They are produced by the offline CLI with the commands and seeds recorded in
 ships which files is its registration's business (``shipped_repertoire`` and
 ``shipped_arbitrator``, :mod:`evorbc_ros.robots.registry`): relative paths are in
 ``evorbc_ros/data``, a plugin gives absolute ones.
+
+The shipped arbitrator is the robot's default controller. When that default is not the
+paper protocol's (one trained on generated mazes, say), the registration's
+``paper_arbitrator`` names the paper-protocol one, for the same repertoire: the paper
+check and ``--paper`` (``evorbc-evolve evaluate``, ``evorbc-sim``) use
+:func:`paper_arbitrator`.
 """
 
 from __future__ import annotations
@@ -15,6 +21,11 @@ from evorbc_ros.robots import registry
 from evorbc_ros.robots.registry import DEFAULT_ROBOT
 
 DATA_DIR = Path(__file__).resolve().parent / "data"
+#: The error of ``--paper`` given with ``--arbitrator`` (evorbc-evolve evaluate, evorbc-sim).
+PAPER_WITH_FILE = (
+    "--paper and --arbitrator cannot be combined: --paper picks the paper-protocol "
+    "controller shipped for --robot"
+)
 
 
 def _shipped(robot: str, kind: str) -> Path:
@@ -23,7 +34,11 @@ def _shipped(robot: str, kind: str) -> Path:
     For a robot that ships none, the path it would have in ``evorbc_ros/data``, which does
     not exist, so loading it says so.
     """
-    name = getattr(registry.lookup(robot), f"shipped_{kind}") or f"{robot}.{kind}.json"
+    return _in_data(getattr(registry.lookup(robot), f"shipped_{kind}") or f"{robot}.{kind}.json")
+
+
+def _in_data(name: str) -> Path:
+    """``name`` if absolute, else in ``evorbc_ros/data``."""
     path = Path(name)
     return path if path.is_absolute() else DATA_DIR / path
 
@@ -36,6 +51,16 @@ def default_repertoire(robot: str = DEFAULT_ROBOT) -> Path:
 def default_arbitrator(robot: str = DEFAULT_ROBOT) -> Path:
     """The shipped EvoRBC arbitrator file for ``robot``."""
     return _shipped(robot, "arbitrator")
+
+
+def paper_arbitrator(robot: str = DEFAULT_ROBOT) -> Path:
+    """The paper-protocol arbitrator file for ``robot`` (trained on the paper's mazes only).
+
+    Its registration's ``paper_arbitrator``, or the shipped arbitrator when that field is
+    "" (the shipped one is the paper protocol's). Both go with :func:`default_repertoire`.
+    """
+    name = registry.lookup(robot).paper_arbitrator
+    return _in_data(name) if name else default_arbitrator(robot)
 
 
 def ships_controller(robot: str) -> bool:

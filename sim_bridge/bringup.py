@@ -24,13 +24,13 @@ from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.cli_support import OneLineParser, check_output_file, integer_in, report_unexpected
 from evorbc_ros.config import ConfigError
-from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, ships_controller
+from evorbc_ros.defaults import PAPER_WITH_FILE, no_shipped_controller, ships_controller
 from evorbc_ros.nodes.common import StartupError
 from evorbc_ros.repertoire import RepertoireError
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
 from sim_bridge.bridge_node import SimBridgeNode, episode_verdict
-from sim_bridge.graph import NodeSpec, exit_ends_graph, sim_graph
+from sim_bridge.graph import NodeSpec, exit_ends_graph, shipped_arbitrator, sim_graph
 from sim_bridge.maze import Maze, load_named_maze, maze_names
 
 #: Highest ROS_DOMAIN_ID: DDS derives UDP ports from it, and above 232 they pass 65535.
@@ -62,6 +62,12 @@ def parse_args(argv=None) -> argparse.Namespace:
     )
     p.add_argument(
         "--arbitrator", default="", help="arbitrator file (default: the shipped one for --robot)"
+    )
+    p.add_argument(
+        "--paper",
+        action="store_true",
+        help="run the paper-protocol controller shipped for --robot (trained on the paper's "
+        "mazes only) instead of its default one; not with --arbitrator",
     )
     p.add_argument(
         "--repertoire",
@@ -199,12 +205,14 @@ def prepare(args: argparse.Namespace) -> tuple[Controller, Maze, str]:
         The controller the arbitrator node will load, the maze and the picture path.
 
     """
+    if args.paper and args.arbitrator:
+        raise ConfigError(PAPER_WITH_FILE)
     if not args.arbitrator and args.robot and not ships_controller(args.robot):
         raise ConfigError(
             f"{no_shipped_controller(args.robot)}, then run "
             "'evorbc-sim --arbitrator a.json --repertoire r.json'"
         )
-    arb_path = args.arbitrator or str(default_arbitrator(args.robot or DEFAULT_ROBOT))
+    arb_path = args.arbitrator or shipped_arbitrator(args.robot or DEFAULT_ROBOT, args.paper)
     controller = Controller(arb_path, args.repertoire)
     arb = controller.spec
     if args.robot and arb.robot != args.robot:

@@ -7,10 +7,11 @@ rclpy nor ``launch``, so the launch logic is tested wherever the project's tests
 (docs/design.md section 10).
 
 Both fill in the same defaults: the robot's shipped controller when no arbitrator is given
-(none for a 4WS type other than 4ws-5: the arbitrator node then refuses to start and says
-how to make one), the robot's maze, simulated time for the four evorbc nodes, the
-parameter files ``config/ros/*.yaml`` under every node, and the ``robot`` parameter on the
-arbitrator, which refuses a controller for another robot.
+(its paper-protocol one with ``paper``; none for a 4WS type other than 4ws-5: the
+arbitrator node then refuses to start and says how to make one), the robot's maze,
+simulated time for the four evorbc nodes, the parameter files ``config/ros/*.yaml`` under
+every node, and the ``robot`` parameter on the arbitrator, which refuses a controller for
+another robot.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from evorbc_ros.config import ConfigError, config_dir
-from evorbc_ros.defaults import default_arbitrator, ships_controller
+from evorbc_ros.defaults import default_arbitrator, paper_arbitrator, ships_controller
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.registry import DEFAULT_ROBOT
 
@@ -57,6 +58,12 @@ ARGUMENTS = (
         "arbitrator",
         "",
         "arbitrator file (JSON); empty: the one shipped for robot (4ws-5 and hexapod ship one)",
+    ),
+    Argument(
+        "paper",
+        "false",
+        "true: the paper-protocol controller shipped for robot (trained on the paper's mazes "
+        "only) instead of its default one; not with arbitrator",
     ),
     Argument(
         "repertoire",
@@ -107,9 +114,14 @@ class SimGraph:
         return next(n for n in self.nodes if n.name == name)
 
 
-def shipped_arbitrator(robot: str) -> str:
-    """The shipped arbitrator file for ``robot``, or "" if none ships for it."""
-    return str(default_arbitrator(robot)) if ships_controller(robot) else ""
+def shipped_arbitrator(robot: str, paper: bool = False) -> str:
+    """The shipped arbitrator file for ``robot``, or "" if none ships for it.
+
+    With ``paper``, its paper-protocol arbitrator (:func:`evorbc_ros.defaults.paper_arbitrator`).
+    """
+    if not ships_controller(robot):
+        return ""
+    return str((paper_arbitrator if paper else default_arbitrator)(robot))
 
 
 def default_maze(robot: str) -> str:
@@ -129,17 +141,26 @@ def sim_graph(
     namespace: str = "",
     result_file: str = "",
     record_file: str = "",
+    paper: bool = False,
 ) -> SimGraph:
     """The graph that runs ``arbitrator`` (default: the one shipped for ``robot``) in a maze.
 
+    ``paper`` picks the robot's shipped paper-protocol arbitrator instead of its default.
+
     Raises:
-        ConfigError: an unknown robot or mode (one line naming the argument).
+        ConfigError: an unknown robot or mode, or ``paper`` with ``arbitrator`` (one line
+            naming the argument).
     """
     if not registry.known(robot):
         raise ConfigError(f"robot must be one of {', '.join(registry.names())}, got {robot!r}")
     if mode not in MODES:
         raise ConfigError(f"mode must be lockstep or realtime, got {mode!r}")
-    arbitrator = arbitrator or shipped_arbitrator(robot)
+    if paper and arbitrator:
+        raise ConfigError(
+            "paper cannot be combined with arbitrator: paper picks the paper-protocol "
+            "controller shipped for robot"
+        )
+    arbitrator = arbitrator or shipped_arbitrator(robot, paper)
     nodes_file = config_dir() / "ros" / "evorbc_nodes.yaml"
     sim_time = {"use_sim_time": True}
 
@@ -195,9 +216,7 @@ def graph_from_arguments(values: dict[str, str]) -> SimGraph:
         ConfigError: one line naming the argument and what it takes.
     """
     given = {a.name: values.get(a.name, a.default) for a in ARGUMENTS}
-    gui = given["gui"].strip().lower()
-    if gui not in ("true", "false"):
-        raise ConfigError(f"argument gui must be true or false, got {given['gui']!r}")
+    gui, paper = (_boolean(given, name) for name in ("gui", "paper"))
     try:
         seed = int(given["seed"])
     except ValueError:
@@ -209,15 +228,24 @@ def graph_from_arguments(values: dict[str, str]) -> SimGraph:
             robot=given["robot"],
             maze=given["maze"],
             mode=given["mode"],
-            gui=gui == "true",
+            gui=gui,
             arbitrator=given["arbitrator"],
             repertoire=given["repertoire"],
             start=given["start"],
             seed=seed,
             namespace=given["namespace"],
+            paper=paper,
         )
     except ConfigError as e:
         raise ConfigError(f"argument {e}") from None
+
+
+def _boolean(given: dict[str, str], name: str) -> bool:
+    """Launch argument ``name`` (``true`` or ``false``, any case) as a bool."""
+    value = given[name].strip().lower()
+    if value not in ("true", "false"):
+        raise ConfigError(f"argument {name} must be true or false, got {given[name]!r}")
+    return value == "true"
 
 
 def exit_ends_graph(node: NodeSpec, returncode: int | None) -> str:

@@ -19,14 +19,14 @@ class DropoutRun(GraphRun):
     """The lockstep graph with the dropout relay (tests/scan_dropout_relay.py) feeding the
     laser node; ``counts()`` gives the scans relayed and the readings published."""
 
-    def __init__(self, tmp_path, domain, maze, dropout, dead_sector, seed=1):
+    def __init__(self, tmp_path, domain, maze, dropout, dead_sector, seed=1, arbitrator=None):
         self.relay_params = {
             "dropout": dropout,
             "dead_sector": dead_sector,
             "seed": seed,
             "count_file": str(tmp_path / "counts.json"),
         }
-        super().__init__(tmp_path, domain, maze)
+        super().__init__(tmp_path, domain, maze, arbitrator=arbitrator)
 
     def start(self, name, module, params):
         if name == "sim_bridge":

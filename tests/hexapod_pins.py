@@ -15,7 +15,7 @@ import numpy as np
 from neat_helpers import neat_config, network_spec, random_genomes
 
 from evorbc_ros.arbitrator import ArbitratorFile
-from evorbc_ros.defaults import default_arbitrator, default_repertoire
+from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.maze_task.perturbation import PerturbationSet, load_perturbations
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
@@ -67,7 +67,7 @@ def cases() -> dict:
       :data:`HARSH`, 4 s episodes.
     """
     out = {}
-    arb = ArbitratorFile.load(default_arbitrator("hexapod"))
+    arb = ArbitratorFile.load(paper_arbitrator("hexapod"))
     rep = Repertoire.load(default_repertoire("hexapod"))
     task = make_task(MazeTaskSettings(**arb.evolution["task"]), "hexapod", workers=1)
     try:

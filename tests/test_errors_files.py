@@ -21,6 +21,9 @@ from sim_bridge import bringup
 
 ARB = json.loads(default_arbitrator().read_text())
 REP = json.loads(default_repertoire().read_text())
+#: The shipped arbitrator's input count (the paper's layout gives 10; a default with another
+#: layout, other numbers).
+N_IN = len(ARB["inputs"])
 
 
 def write(tmp_path, name, data, edit=None):
@@ -71,8 +74,8 @@ def other_robot(data):
             "inputs do not match the sensors section (inputs[0] is 'x', the sensor layout's "
             "is 'range_000')",
         ),
-        (lambda d: d["inputs"].pop(), "9 input names, the sensor layout gives 10"),
-        (lambda d: d.pop("inputs"), "inputs must list the 10 input names"),
+        (lambda d: d["inputs"].pop(), f"{N_IN - 1} input names, the sensor layout gives {N_IN}"),
+        (lambda d: d.pop("inputs"), f"inputs must list the {N_IN} input names"),
         (lambda d: d.pop("sensors_fingerprint"), "missing key sensors_fingerprint"),
         (lambda d: d.update(robot="foo"), "robot 'foo' is not known; known robots: 2ws-2"),
         (lambda d: d.update(robot=5), "robot 5 is not known"),

@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from evorbc_ros.arbitrator import ArbitratorFile
-from evorbc_ros.defaults import default_arbitrator, default_repertoire
+from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.cli import main
 from offline_evolution.maze_task.base import MazeTaskSettings
@@ -30,7 +30,8 @@ ZERO = PerturbationSet(name="zero", **{k: (v[0], v[0]) for k, v in QUANTITIES.it
 
 @functools.cache
 def shipped_4ws():
-    arb = ArbitratorFile.load(default_arbitrator("4ws-5"))
+    """The paper-protocol 4ws-5 controller (its 4-sector layout) in the paper mazes."""
+    arb = ArbitratorFile.load(paper_arbitrator("4ws-5"))
     task = make_task(MazeTaskSettings(PAPER, 120.0, 1, "sensors/4ws.yaml"), "4ws-5")
     controller = task.controller("evorbc", Repertoire.load(default_repertoire()), arb.mapping)
     return task, arb.network, controller
@@ -50,18 +51,15 @@ def outcome(suite):
 
 def test_shipped_4ws_controller_reaches_the_target_from_most_random_starts(tmp_path, capsys):
     out, picture = tmp_path / "report.json", tmp_path / "suite.png"
-    assert (
-        main(
-            ["evaluate", "--starts", "20", "--seed", "1", "--out", str(out), "--plot", str(picture)]
-        )
-        == 0
-    )
+    argv = ["evaluate", "--paper", "--starts", "20", "--seed", "1", "--out", str(out)]
+    assert main([*argv, "--plot", str(picture)]) == 0
     table = capsys.readouterr().out
     report = json.loads(out.read_text())
+    assert report["arbitrator"] == str(paper_arbitrator("4ws-5"))
     assert report["mazes"] == list(PAPER) and report["perturbation"]["name"] == "none"
     assert [r["episodes"] for r in report["per_maze"]] == [20] * 5
     overall = report["overall"]
-    print(f"shipped 4ws-5, paper mazes, 5 x 20 random starts (seed 1): {overall}")
+    print(f"paper-protocol 4ws-5, paper mazes, 5 x 20 random starts (seed 1): {overall}")
     # The issue measured 95 %; seeds 0-3 give 91-94 % here.
     assert overall["reach_rate"] >= 0.9
     assert overall["reached"] == sum(e["reached"] for e in report["episodes"])
@@ -115,7 +113,7 @@ def test_the_4ws_kinematic_model_names_what_it_cannot_perturb():
 
 @pytest.mark.slow
 def test_hexapod_perturbations_act_and_are_undone():
-    arb = ArbitratorFile.load(default_arbitrator("hexapod"))
+    arb = ArbitratorFile.load(paper_arbitrator("hexapod"))
     settings = MazeTaskSettings(("hexapod",), 3.0, 1, "sensors/hexapod.yaml")
     task = make_task(settings, "hexapod", workers=1)
     rep = Repertoire.load(default_repertoire("hexapod"))

@@ -7,7 +7,11 @@ import numpy as np
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Float64MultiArray
 
+from evorbc_ros.config import config_dir
 from evorbc_ros.nodes.laser_sensor import LaserSensorNode
+
+#: The paper's layout (rangefinders every 60 deg from 0), whichever controller ships.
+PAPER_LAYOUT = str(config_dir() / "sensors" / "4ws.yaml")
 
 
 class Log:
@@ -41,7 +45,7 @@ def message(ranges, angle_min=-math.pi, increment=None, angle_max=None, range_mi
 
 
 def test_dropouts_are_bridged_through_the_topic(ros):
-    ros.make(LaserSensorNode)
+    ros.make(LaserSensorNode, sensor_layout=PAPER_LAYOUT)
     out = ros.listen(Float64MultiArray, "evorbc/rangefinders")
     pub = ros.publisher(LaserScan, "scan")
     ros.connected(pub)
@@ -53,7 +57,7 @@ def test_dropouts_are_bridged_through_the_topic(ros):
 
 
 def test_refusals_are_logged_with_their_reason(ros):
-    node = ros.make(LaserSensorNode)
+    node = ros.make(LaserSensorNode, sensor_layout=PAPER_LAYOUT)
     log, _ = quiet(node)
     node.on_scan(message(np.full(360, 0.01), range_min=0.02))
     node.on_scan(message(np.full(360, 0.5), angle_max=math.pi / 2))
@@ -70,7 +74,7 @@ def test_refusals_are_logged_with_their_reason(ros):
 
 def test_an_offset_scanner_is_warned_about_once(ros):
     # A 180-deg scanner 0.1 m ahead of the centre sees nothing behind itself.
-    node = ros.make(LaserSensorNode, laser_x=0.1)
+    node = ros.make(LaserSensorNode, laser_x=0.1, sensor_layout=PAPER_LAYOUT)
     log, out = quiet(node)
     for _ in range(3):
         node.on_scan(message(np.full(181, 0.4), angle_min=-math.pi / 2, increment=math.pi / 180))

@@ -19,7 +19,7 @@ from hexapod_pins import cases, digest
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.config import config_dir
-from evorbc_ros.defaults import default_arbitrator, default_repertoire
+from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.hexapod import GaitTable, HexapodGeometry, hexapod_gait, mirror_genes
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
@@ -97,7 +97,7 @@ def test_the_hexapod_robot_is_the_settings_files_legged_robot(from_yaml):
 
 @pytest.fixture(scope="module")
 def shipped():
-    arb = ArbitratorFile.load(default_arbitrator("hexapod"))
+    arb = ArbitratorFile.load(paper_arbitrator("hexapod"))
     repertoire = Repertoire.load(default_repertoire("hexapod"))
     task = make_task(MazeTaskSettings(**arb.evolution["task"]), "hexapod", workers=1)
     controller = task.controller("evorbc", repertoire, arb.mapping)

@@ -16,7 +16,7 @@ from graph_helpers import GraphRun, assert_same_choices
 
 from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorFile
-from evorbc_ros.defaults import default_arbitrator, default_repertoire
+from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.executor import NO_PRIMITIVE_REASON, PrimitiveExecutor
 from evorbc_ros.hexapod_executor import HexapodExecutor
 from evorbc_ros.mapping import (
@@ -33,8 +33,10 @@ from offline_evolution.maze_task import kernel
 from offline_evolution.maze_task.replay import replay
 from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
 
-ARB = json.loads(default_arbitrator().read_text())
-HEX_ARB = json.loads(default_arbitrator("hexapod").read_text())
+# The paper-protocol networks: the edits below know their nodes and inputs, and the
+# episodes their paths (baffles: drives about 29 s, then stops).
+ARB = json.loads(paper_arbitrator().read_text())
+HEX_ARB = json.loads(paper_arbitrator("hexapod").read_text())
 
 
 def cube_1e300(data):

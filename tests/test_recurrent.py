@@ -125,9 +125,10 @@ def test_a_signal_crosses_one_connection_per_step():
 
 
 def arbitrator_dict(network: NetworkSpec) -> dict:
-    from evorbc_ros.defaults import default_arbitrator
+    """The paper-protocol 4ws-5 file (the paper's layout, as ``network``'s) with ``network``."""
+    from evorbc_ros.defaults import paper_arbitrator
 
-    data = json.loads(default_arbitrator().read_text())
+    data = json.loads(paper_arbitrator().read_text())
     n_in = len(data["network"]["inputs"])
     assert n_in == len(network.input_keys)
     data["network"] = network.to_dict()

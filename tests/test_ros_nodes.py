@@ -19,7 +19,8 @@ from evorbc_ros.nodes.primitive_executor import PrimitiveExecutorNode
 from evorbc_ros.nodes.radar_sensor import RadarSensorNode
 from evorbc_ros.sensors import SensorLayout
 
-LAYOUT = SensorLayout.load(config_dir() / "sensors" / "4ws.yaml")
+LAYOUT_FILE = config_dir() / "sensors" / "4ws.yaml"  # the paper's: 6 rangefinders, 4 sectors
+LAYOUT = SensorLayout.load(LAYOUT_FILE)
 
 
 def scan(ranges, angle_min=-math.pi, increment=None):
@@ -33,7 +34,7 @@ def scan(ranges, angle_min=-math.pi, increment=None):
 
 
 def test_laser_node_publishes_readings_and_skips_malformed_scans(ros):
-    node = ros.make(LaserSensorNode, laser_yaw=0.0)
+    node = ros.make(LaserSensorNode, laser_yaw=0.0, sensor_layout=str(LAYOUT_FILE))
     out = ros.listen(Float64MultiArray, "evorbc/rangefinders")
     pub = ros.publisher(LaserScan, "scan")
     ros.connected(pub)
@@ -50,7 +51,7 @@ def test_laser_node_publishes_readings_and_skips_malformed_scans(ros):
 
 
 def test_radar_node_publishes_goal_sectors(ros):
-    node = ros.make(RadarSensorNode)
+    node = ros.make(RadarSensorNode, sensor_layout=str(LAYOUT_FILE))
     out = ros.listen(Float64MultiArray, "evorbc/goal_sectors")
     goal_pub = ros.publisher(PointStamped, "goal", LATCHED)
     odom_pub = ros.publisher(Odometry, "odom")

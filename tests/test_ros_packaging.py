@@ -224,8 +224,8 @@ def test_ros2_launch_shows_every_argument_with_its_description(prefix):
 
 @needs_ros2
 def test_ros2_launch_runs_an_episode_in_a_namespace_and_then_shuts_the_graph_down(prefix):
-    out = ros2_launch(prefix, 171, "maze:=zigzag", "namespace:=robot1")
-    # The shipped controller, as offline (evorbc_ros/data/README.md: zigzag 86.0 s, 1.283).
+    out = ros2_launch(prefix, 171, "maze:=zigzag", "namespace:=robot1", "paper:=true")
+    # The paper-protocol controller, as offline (evorbc_ros/data/README.md: zigzag 86.0 s, 1.283).
     assert "[robot1.sim_bridge]: reached the target in 86.0 s; fitness 1.283" in out
     assert re.search(r"process\[sim_bridge-\d\] was required: shutting down", out)
     assert out.count("process has finished cleanly") == 5

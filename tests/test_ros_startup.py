@@ -12,6 +12,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ros_helpers import ros_with_args
 from std_msgs.msg import Float64MultiArray
 
+from evorbc_ros.config import config_dir
 from evorbc_ros.defaults import default_arbitrator
 from evorbc_ros.nodes.arbitrator import ArbitratorNode
 from evorbc_ros.nodes.common import LATCHED, RELIABLE, StartupError, vector_message
@@ -173,7 +174,10 @@ def test_rviz_goal_poses_are_taken_through_a_remapping(monkeypatch):
     """RViz's goal tool: PoseStamped on /goal_pose, reliable and volatile."""
     monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")
     with ros_with_args("-r", "radar_sensor:goal:=/goal_pose") as ros:
-        node = ros.make(RadarSensorNode, goal_type="pose")
+        # The paper's four goal sectors, whichever controller ships (its layout is the
+        # node's default).
+        layout = str(config_dir() / "sensors" / "4ws.yaml")
+        node = ros.make(RadarSensorNode, goal_type="pose", sensor_layout=layout)
         out = ros.listen(Float64MultiArray, "evorbc/goal_sectors")
         pub = ros.publisher(PoseStamped, "/goal_pose", RELIABLE)
         ros.connected(pub)

@@ -1,13 +1,13 @@
-"""The shipped legged controllers (evorbc_ros/data/hexapod.*, a1.*): each walks its maze to
-the target from the nominal start offline, and the ROS 2 graph in lockstep makes the same
-choices and reaches it too."""
+"""The shipped paper-protocol legged controllers (evorbc_ros/data/hexapod.*, a1.*;
+``paper_arbitrator``): each walks its maze to the target from the nominal start offline,
+and the ROS 2 graph in lockstep makes the same choices and reaches it too."""
 
 import numpy as np
 import pytest
 from graph_helpers import GraphRun, assert_same_choices
 
 from evorbc_ros.arbitrator import ArbitratorFile
-from evorbc_ros.defaults import default_arbitrator, default_repertoire
+from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.maze_task.replay import replay
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
@@ -25,7 +25,7 @@ SHIPPED = {
 def offline(request):
     """A shipped legged controller replayed offline from its maze's nominal start."""
     robot = request.param
-    arb = ArbitratorFile.load(default_arbitrator(robot))
+    arb = ArbitratorFile.load(paper_arbitrator(robot))
     repertoire = Repertoire.load(default_repertoire(robot))
     task = make_task(MazeTaskSettings(**arb.evolution["task"]), robot, workers=1)
     try:
@@ -55,7 +55,7 @@ def test_lockstep_graph_walks_the_shipped_controller_to_the_target(tmp_path, off
     robot, _, _, outcome, result = offline
     run = GraphRun(
         tmp_path, SHIPPED[robot]["domain"], robot, episode_time=30.0,
-        arbitrator=default_arbitrator(robot), robot=robot,
+        arbitrator=paper_arbitrator(robot), robot=robot,
     )  # fmt: skip
     got = run.finish(timeout=300)
     cycles = assert_same_choices(run.recorded_choices(), result)

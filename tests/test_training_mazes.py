@@ -275,7 +275,8 @@ def test_hexapod_episodes_in_a_generated_maze_match_the_maze_as_a_file(tmp_path)
 
     arb = ArbitratorFile.load(default_arbitrator("hexapod"))
     repertoire = Repertoire.load(default_repertoire("hexapod"))
-    values = {"mazes": ["hexapod"], "episode_time": 2.0, "sensors": "sensors/hexapod.yaml"}
+    sensors = arb.evolution["task"]["sensors"]  # the controller's own layout, whichever ships
+    values = {"mazes": ["hexapod"], "episode_time": 2.0, "sensors": sensors}
     training = {"generated": 1, "starts": 1, "task_mazes": False, "maze_seed": 3}
     task = make_task(
         MazeTaskSettings.from_dict({**values, "training": training}, "t"), "hexapod", 1

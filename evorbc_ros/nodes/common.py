@@ -291,17 +291,22 @@ def robot_named(name: str):
 def load_sensor_layout(path: str):
     """The sensor layout from a layout YAML, an arbitrator file, or the default robot's.
 
-    The default robot's layout is the shipped 4WS one.
+    The default robot's layout (``path`` empty) is that of its shipped controller, which the
+    arbitrator node runs when given none, so nodes started without parameters fit together
+    whatever layout that controller has; for a default robot shipping none, its sensors file.
 
     Raises:
         StartupError: naming the file and the problem.
     """
     from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
     from evorbc_ros.config import ConfigError
+    from evorbc_ros.defaults import default_arbitrator, ships_controller
     from evorbc_ros.robots.registry import DEFAULT_ROBOT, lookup
     from evorbc_ros.sensors import SensorLayout
 
     try:
+        if not path and ships_controller(DEFAULT_ROBOT):
+            return ArbitratorFile.load(default_arbitrator(DEFAULT_ROBOT)).sensors
         if not path:
             return SensorLayout.load(lookup(DEFAULT_ROBOT).sensors_file())
         if path.endswith(".json"):
@@ -321,7 +326,7 @@ def sensor_layout_parameter(node: Node):
         node,
         "sensor_layout",
         "",
-        "sensor layout YAML or arbitrator JSON; empty: the shipped 4WS layout",
+        "sensor layout YAML or arbitrator JSON; empty: the shipped 4ws-5 controller's",
     )
     return load_sensor_layout(path)
 

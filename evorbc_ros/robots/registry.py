@@ -128,6 +128,12 @@ class Robot:
         shipped_repertoire: the repertoire shipped for it ("" for none), relative to
             ``evorbc_ros/data`` or absolute.
         shipped_arbitrator: the arbitrator shipped with that repertoire ("" for none).
+        paper_arbitrator: the paper-protocol arbitrator (trained on the paper's mazes
+            only) when the shipped default is another, e.g. one trained on generated
+            mazes; "" means the shipped arbitrator is the paper protocol's. Relative to
+            ``evorbc_ros/data`` or absolute, for the shipped repertoire; it needs a
+            shipped controller. ``--paper`` and the tests pinning the paper protocol's
+            figures use it.
         design_check: optional ``f(robot, controller)`` raising ``ConfigError`` when
             ``evorbc-sim`` is given a controller evolved for another design than the
             bridge simulates (the hexapod's geometry, physics and laser).
@@ -158,6 +164,7 @@ class Robot:
     episode_bytes: int = 400
     shipped_repertoire: str = ""
     shipped_arbitrator: str = ""
+    paper_arbitrator: str = ""
     design_check: str = ""
     model: Any = None
     node_defaults: tuple[tuple[str, Any], ...] = ()
@@ -268,6 +275,11 @@ def registration_problem(robot: Any) -> str | None:
         return f"{where}: command_topics must be a non-empty tuple of topic names"
     if bool(robot.shipped_repertoire) != bool(robot.shipped_arbitrator):
         return f"{where}: a shipped controller needs both shipped_repertoire and shipped_arbitrator"
+    if robot.paper_arbitrator and not robot.shipped_arbitrator:
+        return (
+            f"{where}: paper_arbitrator needs a shipped controller (shipped_repertoire and "
+            "shipped_arbitrator)"
+        )
     return None
 
 

@@ -12,7 +12,13 @@ from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.config import ConfigError
-from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, ships_controller
+from evorbc_ros.defaults import (
+    PAPER_WITH_FILE,
+    default_arbitrator,
+    no_shipped_controller,
+    paper_arbitrator,
+    ships_controller,
+)
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
 from offline_evolution.commands.common import CliError, at_least, count
 from offline_evolution.commands.replay import check_task, controller_inputs
@@ -43,6 +49,12 @@ def add_parsers(sub) -> None:
         choices=ROBOT_NAMES,
         default=DEFAULT_ROBOT,
         help="whose shipped controller, without --arbitrator",
+    )
+    p.add_argument(
+        "--paper",
+        action="store_true",
+        help="the paper-protocol controller shipped for --robot (trained on the paper's "
+        "mazes only) instead of its default one; not with --arbitrator",
     )
     p.add_argument("--repertoire", metavar="FILE", help="repertoire of an EvoRBC arbitrator")
     p.add_argument(
@@ -104,12 +116,14 @@ def suite_mazes(given: list[str] | None, trained: tuple[str, ...], generated: bo
 
 def load_arbitrator(args) -> tuple[ArbitratorFile, Path]:
     """The arbitrator to evaluate and its path."""
+    if args.arbitrator and args.paper:
+        raise CliError(PAPER_WITH_FILE)
     if args.arbitrator:
         path = Path(args.arbitrator)
     else:
         if not ships_controller(args.robot):
             raise CliError(f"{no_shipped_controller(args.robot)}; pass --arbitrator FILE")
-        path = default_arbitrator(args.robot)
+        path = (paper_arbitrator if args.paper else default_arbitrator)(args.robot)
     return ArbitratorFile.load(path), path
 
 

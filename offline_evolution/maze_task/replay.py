@@ -52,7 +52,17 @@ def replay(
     """Run ``arbitrator`` from each ``starts`` row ``(maze, x, y, heading)``, recording.
 
     ``task`` is either maze task (the 4WS robots' or the hexapod's).
+
+    Raises:
+        ValueError: the network takes another number of inputs than the task's sensor
+            layout gives (the episodes would read inputs that are not there).
     """
+    n_net, n_task = len(arbitrator.network.input_keys), task.layout.n_inputs
+    if n_net != n_task:
+        raise ValueError(
+            f"the arbitrator's network takes {n_net} inputs, the task's sensor layout gives "
+            f"{n_task}: make the task with the arbitrator's sensors"
+        )
     controller = task.controller(arbitrator.kind, repertoire, arbitrator.mapping)
     result = task.evaluate([arbitrator.network], controller, starts, record=True)
     outcomes = []
