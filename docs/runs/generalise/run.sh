@@ -20,15 +20,4 @@ fi
 # A run trained with other episodes than the others is evaluated like them: tasks/NAME.eval.yaml.
 evaltask=""
 [ -f $dir/tasks/$name.eval.yaml ] && evaltask="--task $dir/tasks/$name.eval.yaml"
-# paper: the five paper mazes; held: the 50 held-out mazes; heldr: those under `realistic`.
-for suite in paper held heldr; do
-  [ -f $out.$suite.json ] && continue
-  case $suite in
-    paper) extra="$evaltask --perturb none" ;;
-    held) extra="--generated 50 $evaltask --perturb none" ;;
-    heldr) extra="--generated 50 $evaltask --perturb realistic" ;;
-  esac
-  .venv/bin/evorbc-evolve evaluate --arbitrator $out.arbitrator.json $extra --starts 20 \
-    --repertoire evorbc_ros/data/4ws-5.repertoire.json --json | .venv/bin/python $dir/summary.py > $out.$suite.tmp
-  mv $out.$suite.tmp $out.$suite.json
-done
+sh $dir/evaluate.sh $out $evaltask

@@ -20,8 +20,8 @@ evolve() {
 if [ ! -f $out-g300.arbitrator.json ]; then
   evolve --generations 300 --keep-checkpoint --out $out-g300.arbitrator.json
 fi
-sh $dir/evaluate.sh $out-g300
+sh docs/runs/generalise/evaluate.sh $out-g300
 if [ ! -f $out.arbitrator.json ] || [ -f $out.checkpoint.json ]; then
   evolve --generations $gens --out $out.arbitrator.json
 fi
-sh $dir/evaluate.sh $out
+sh docs/runs/generalise/evaluate.sh $out
