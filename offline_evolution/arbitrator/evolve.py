@@ -91,7 +91,7 @@ class EvolutionSettings:
     mapping: str | None = None
     repertoire_fingerprint: str | None = None
     hall_of_fame: int = 25  # genomes kept for the final post-evaluation
-    post_samples: int = 10  # random starts per maze in the post-evaluation
+    post_samples: int = 10  # post-evaluation draws of the task's random starts
     post_rule: str = "mean"  # how the post-evaluation picks the written genome (selection.RULES)
     # Each generation's best this many genomes are also run from every maze's nominal
     # start; those that reach the target there join the hall of fame (0: none).

@@ -23,7 +23,11 @@ class ArbitratorRunSettings:
     task: str = setting("tasks/maze-4ws.yaml", doc="task settings file, relative to config/")
     checkpoint_every: int = setting(10, doc="generations between checkpoints", minimum=1)
     hall_of_fame: int = setting(25, doc="genomes kept for the post-evaluation", minimum=1)
-    post_samples: int = setting(10, doc="random starts per maze in the post-evaluation", minimum=0)
+    post_samples: int = setting(
+        10,
+        doc="post-evaluation draws of the task's random starts (samples_per_maze a maze each)",
+        minimum=0,
+    )
     post_rule: str = setting(
         "mean", doc="how the post-evaluation picks the controller to write", choices=RULES
     )
