@@ -73,7 +73,8 @@ def check_evolution_memory(
         task: the :class:`~offline_evolution.maze_task.task.MazeTaskSettings`.
         pop_size: NEAT's population.
         source: the task settings' file, for the message.
-        post_candidates: genomes the post-evaluation re-runs (at most 3 x hall_of_fame).
+        post_candidates: genomes the post-evaluation re-runs (at most 3 x hall_of_fame, plus
+            the snapshots of `snapshot_every`).
         post_samples: its random starts per maze (plus the nominal one).
     """
     mazes = len(task.mazes)

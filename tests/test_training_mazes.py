@@ -49,6 +49,19 @@ def training_task(**training) -> MazeTask:
     return task
 
 
+def interrupt(settings, repertoire, checkpoint, after: int) -> None:
+    """Run ``settings`` until its ``after``-th stop poll, leaving ``checkpoint``."""
+    polls = []
+    with pytest.raises(Interrupted):
+        evolve(
+            settings,
+            repertoire,
+            checkpoint=checkpoint,
+            checkpoint_every=100,
+            should_stop=lambda: polls.append(1) or len(polls) == after,
+        )
+
+
 def histories(result):
     out = []
     for h in result.history:
@@ -150,15 +163,7 @@ def test_every_genome_sees_the_same_draw_and_resume_is_exact(
     s = run_settings(small_neat_file, small_repertoire, task_dict(pool=0))
     straight = evolve(s, small_repertoire)
     ckpt = tmp_path / "run.checkpoint.json"
-    polls = []
-    with pytest.raises(Interrupted):
-        evolve(
-            s,
-            small_repertoire,
-            checkpoint=ckpt,
-            checkpoint_every=100,
-            should_stop=lambda: polls.append(1) or len(polls) == 2,
-        )
+    interrupt(s, small_repertoire, ckpt, after=2)
     resumed = evolve(s, small_repertoire, checkpoint=ckpt)
     assert histories(resumed) == histories(straight)
     assert resumed.best_network == straight.best_network

@@ -49,6 +49,7 @@ from offline_evolution.arbitrator.selection import (
     PostEvaluation,
     post_evaluate,
     post_evaluation_starts,
+    validation_rows,
 )
 from offline_evolution.checkpoint import (
     CheckpointError,
@@ -66,7 +67,10 @@ CHECKPOINT_KIND = "evorbc-neat-checkpoint"
 
 #: EvolutionSettings fields that only decide which genome is written, never how the
 #: population evolves, so they may change when a run resumes from a checkpoint.
-SELECTION_ONLY = ("post_samples", "post_rule", "nominal_watch")
+SELECTION_ONLY = ("post_samples", "post_rule", "nominal_watch", "snapshot_every")
+#: Task keys that only decide which genome is written: the generated validation mazes are
+#: drawn from the post-evaluation's own seed stream, never during evolution.
+TASK_SELECTION_ONLY = ("post_mazes",)
 #: Fields that say where an input lies, not what it holds: the NEAT file's contents are
 #: checked by ``neat_sha256``, so a run resumes in another checkout or folder.
 LOCATION_ONLY = ("neat_file",)
@@ -96,6 +100,9 @@ class EvolutionSettings:
     # Each generation's best this many genomes are also run from every maze's nominal
     # start; those that reach the target there join the hall of fame (0: none).
     nominal_watch: int = 0
+    # The champion of every this-many-th generation joins the hall of fame for good, so the
+    # post-evaluation can choose from the whole run (0: none).
+    snapshot_every: int = 0
 
     def as_dict(self) -> dict:
         """Plain-data form (checkpoints and arbitrator files)."""
@@ -161,6 +168,16 @@ def network_spec(genome, config: neat.Config) -> NetworkSpec:
         ),
         recurrent=not gc.feed_forward,
     )
+
+
+def _without_selection(settings: dict) -> dict:
+    """``settings`` without the task keys of :data:`TASK_SELECTION_ONLY` (a copy)."""
+    task = settings.get("task")
+    training = task.get("training") if isinstance(task, dict) else None
+    if not isinstance(training, dict):
+        return settings
+    kept = {k: v for k, v in training.items() if k not in TASK_SELECTION_ONLY}
+    return {**settings, "task": {**task, "training": kept}}
 
 
 def file_sha256(path: str | os.PathLike, what: str = "NEAT settings") -> str:
@@ -270,6 +287,9 @@ class Evolution:
         # Only the top of a generation can enter the hall: convert just those to dicts.
         ranked = sorted((g for _, g in genomes), key=lambda g: (-g.fitness, g.key))
         self.hall.update([genome_to_dict(g) for g in ranked[: self.hall.size]])
+        every = self.settings.snapshot_every
+        if every and (generation + 1) % every == 0:
+            self.hall.snapshot(genome_to_dict(ranked[0]))
         self._watch_nominal(ranked[: self.settings.nominal_watch], config)
         self._eval_seconds = time.perf_counter() - start
         k = int(np.argmax(fitness))
@@ -336,6 +356,7 @@ class Evolution:
             starts,
             self.settings.post_rule,
             len(self.task.nominal_starts()),
+            validation_rows(self.task, self.settings.post_samples),
         )
         chosen = candidates[post.index]
         return EvolutionResult(
@@ -385,7 +406,7 @@ class Evolution:
         # changes its contents, so both may change between sessions.
         ignored = SELECTION_ONLY + LOCATION_ONLY + LENGTH_ONLY
         saved, now = (
-            {k: v for k, v in d.items() if k not in ignored}
+            _without_selection({k: v for k, v in d.items() if k not in ignored})
             for d in (data["settings"], self.settings.as_dict())
         )
         mismatch = settings_mismatch(saved, now)
@@ -419,9 +440,9 @@ class Evolution:
         self.best_generation = require(data, "best_generation", int)
         self.best_reached = require(data, "best_reached", int)
         hall = require(data, "hall_of_fame", dict)
-        for part in ("top", "recent", "nominal"):
-            if part == "nominal" and part not in hall:
-                continue  # written before the nominal watch existed
+        for part in ("top", "recent", "nominal", "snapshots"):
+            if part in ("nominal", "snapshots") and part not in hall:
+                continue  # written before the nominal watch existed, or without snapshots
             for i, g in enumerate(require(hall, part, list, "hall_of_fame.")):
                 genome_from_dict(g, self.config, f"hall_of_fame.{part}[{i}].")
                 require(g, "fitness", float, f"hall_of_fame.{part}[{i}].")
@@ -527,6 +548,7 @@ def arbitrator_file(
             "nominal_starts": True,
             "hall_of_fame": s.hall_of_fame,
             "nominal_watch": s.nominal_watch,
+            **({"snapshot_every": s.snapshot_every} if s.snapshot_every else {}),
         },
         "seconds": round(result.seconds, 1),
         "neat_settings": Path(s.neat_file).name,

@@ -24,15 +24,22 @@ POST_EVALUATION_STREAM = 2**31 - 1
 #: How the post-evaluation picks the controller to write:
 #: ``mean``: the highest mean fitness over all post-evaluation episodes;
 #: ``nominal_then_mean``: the highest mean among the candidates that reach the target from
-#: every maze's nominal start (where a demo starts the robot), or by ``mean`` when none does.
-RULES = ("mean", "nominal_then_mean")
+#: every maze's nominal start (where a demo starts the robot), or by ``mean`` when none does;
+#: ``balanced``: the highest mean of two means, over the task's own mazes' episodes and over
+#: its generated validation mazes' episodes, so that neither suite outweighs the other by its
+#: number of episodes (equal to ``mean`` for a task without validation mazes).
+RULES = ("mean", "nominal_then_mean", "balanced")
 
 
 class HallOfFame:
     """Genomes kept for the post-evaluation.
 
-    They are the top genomes by training fitness, the latest generations' champions, and
-    the genomes seen to reach the target from every maze's nominal start. Genomes are
+    They are the top genomes by training fitness, the latest generations' champions, the
+    genomes seen to reach the target from every maze's nominal start, and, when the run
+    takes them, snapshots: the champion of every N-th generation, so that the
+    post-evaluation can pick a genome from any part of a long run (a run that trains on
+    fresh generated mazes can drift towards its fixed mazes late in the run; docs/design.md
+    section 8). Genomes are
     kept as plain dicts (``neat_state.genome_to_dict``) so the hall goes into JSON
     checkpoints as it is.
     """
@@ -43,6 +50,7 @@ class HallOfFame:
         self.recent: list[dict] = []  # champions of the last ``size`` generations
         # Reached the target from every nominal start; highest "nominal_fitness" first.
         self.nominal: list[dict] = []
+        self.snapshots: list[dict] = []  # every N-th generation's champion, oldest first
 
     def update(self, genomes: list[dict]) -> None:
         """Offer one generation's genomes (dicts with their training fitness)."""
@@ -67,10 +75,15 @@ class HallOfFame:
         ranked = sorted([*self.nominal, genome], key=lambda g: (-g["nominal_fitness"], g["key"]))
         self.nominal = ranked[: self.size]
 
+    def snapshot(self, genome: dict) -> None:
+        """Keep a generation's champion for good (``snapshot_every``)."""
+        if all(g["key"] != genome["key"] for g in self.snapshots):
+            self.snapshots.append(genome)
+
     def candidates(self) -> list[dict]:
-        """Every genome in the hall once (top first)."""
+        """Every genome in the hall once (top first, snapshots last)."""
         seen, out = set(), []
-        for g in [*self.top, *self.recent, *self.nominal]:
+        for g in [*self.top, *self.recent, *self.nominal, *self.snapshots]:
             if g["key"] not in seen:
                 seen.add(g["key"])
                 out.append(g)
@@ -78,15 +91,19 @@ class HallOfFame:
 
     def to_dict(self) -> dict:
         """Plain-data form for checkpoints."""
-        return {"size": self.size, "top": self.top, "recent": self.recent, "nominal": self.nominal}
+        out = {"size": self.size, "top": self.top, "recent": self.recent, "nominal": self.nominal}
+        if self.snapshots:  # absent otherwise, so that runs without snapshots write as before
+            out["snapshots"] = self.snapshots
+        return out
 
     @classmethod
     def from_dict(cls, data: dict) -> HallOfFame:
-        """Rebuild from :meth:`to_dict` (checkpoints before the nominal list have none)."""
+        """Rebuild from :meth:`to_dict` (older checkpoints lack the nominal list or snapshots)."""
         hall = cls(int(data["size"]))
         hall.top = list(data["top"])
         hall.recent = list(data["recent"])
         hall.nominal = list(data.get("nominal", []))
+        hall.snapshots = list(data.get("snapshots", []))
         return hall
 
 
@@ -122,7 +139,7 @@ def post_evaluation_starts(task: ArbitratorTask, seed: int, samples: int) -> np.
 
     A maze task that trains on generated mazes adds ``samples`` starts in each of its
     generated validation mazes (never the held-out set; docs/design.md section 22) and
-    makes them its current mazes.
+    makes them its current mazes; they are the last :func:`validation_rows` rows.
     """
     rng = np.random.default_rng([seed, POST_EVALUATION_STREAM])
     rows = [task.nominal_starts()] + [task.sample_starts(rng) for _ in range(samples)]
@@ -132,6 +149,14 @@ def post_evaluation_starts(task: ArbitratorTask, seed: int, samples: int) -> np.
     return np.concatenate(rows)
 
 
+def validation_rows(task: ArbitratorTask, samples: int) -> int:
+    """How many of :func:`post_evaluation_starts`' rows lie in generated validation mazes."""
+    training = getattr(task, "training", None)
+    if training is None or samples < 1:
+        return 0
+    return training.settings.post_mazes * samples
+
+
 def post_evaluate(
     task: ArbitratorTask,
     controller,
@@ -139,12 +164,15 @@ def post_evaluate(
     starts: np.ndarray,
     rule: str = "mean",
     nominal_rows: int | None = None,
+    validation: int = 0,
 ) -> PostEvaluation:
     """Score every network on ``starts`` and pick one by ``rule`` (see :data:`RULES`).
 
     ``starts`` begins with the task's ``nominal_rows`` nominal starts (by default one per
-    maze of a maze task), as :func:`post_evaluation_starts` lays them out. Ties go to the
-    earlier candidate (the hall lists the highest training fitness first).
+    maze of a maze task) and ends with ``validation`` rows in generated validation mazes,
+    as :func:`post_evaluation_starts` lays them out. Ties go to the earlier candidate (the
+    hall lists the highest training fitness first). The reported ``fitness`` is the mean
+    over every episode whatever the rule.
     """
     if rule not in RULES:
         raise ValueError(f"post-evaluation rule must be one of {', '.join(RULES)}, got {rule!r}")
@@ -157,7 +185,12 @@ def post_evaluate(
         nominal_rows = len(task.mazes)
     nominal = reached_all[:, :nominal_rows].all(axis=1)
     eligible = nominal if rule == "nominal_then_mean" and nominal.any() else np.ones_like(nominal)
-    k = int(np.argmax(np.where(eligible, fitness, -np.inf)))
+    score = fitness
+    if rule == "balanced" and 0 < validation < n:
+        per_episode = result.fitness.reshape(len(networks), n)
+        own, held = per_episode[:, : n - validation], per_episode[:, n - validation :]
+        score = 0.5 * (own.mean(axis=1) + held.mean(axis=1))
+    k = int(np.argmax(np.where(eligible, score, -np.inf)))
     return PostEvaluation(
         k,
         float(fitness[k]),

@@ -37,6 +37,12 @@ class ArbitratorRunSettings:
         "those that reach join the hall of fame",
         minimum=0,
     )
+    snapshot_every: int = setting(
+        0,
+        doc="the champion of every N-th generation joins the hall of fame for good, so that "
+        "the post-evaluation chooses from the whole run (0: none)",
+        minimum=0,
+    )
 
     def selection(self) -> dict:
         """The keys that choose the genome written (``EvolutionSettings`` fields)."""
@@ -45,6 +51,7 @@ class ArbitratorRunSettings:
             "post_samples": self.post_samples,
             "post_rule": self.post_rule,
             "nominal_watch": self.nominal_watch,
+            "snapshot_every": self.snapshot_every,
         }
 
     def neat_path(self) -> Path:

@@ -243,7 +243,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         pop_size,
         robot,
         str(args.task or run.task_path()),
-        3 * run.hall_of_fame,
+        3 * run.hall_of_fame + (generations // run.snapshot_every if run.snapshot_every else 0),
         run.post_samples,
     )
     every = args.checkpoint_every or run.checkpoint_every

@@ -1,0 +1,96 @@
+"""Choosing the written controller from a whole run: hall-of-fame snapshots, the
+``balanced`` rule, and validation mazes that may change when a run resumes
+(docs/design.md sections 8 and 22)."""
+
+import numpy as np
+import pytest
+from test_evolution import _ScoredTask
+from test_training_mazes import histories, interrupt, run_settings, task_dict
+
+from offline_evolution.arbitrator.evolve import Evolution, EvolutionSettings, evolve
+from offline_evolution.arbitrator.selection import HallOfFame, post_evaluate
+from offline_evolution.checkpoint import Interrupted
+
+
+def test_snapshots_keep_every_nth_champion_and_leave_the_evolution_alone(
+    small_neat_file, small_repertoire
+):
+    base = run_settings(small_neat_file, small_repertoire, task_dict(pool=0), generations=6)
+    plain = evolve(base, small_repertoire)
+    snap = EvolutionSettings(**{**base.as_dict(), "snapshot_every": 2})
+    run = Evolution(snap, small_repertoire)
+    try:
+        champions = []
+        while not run.finished:
+            run.step()
+            # the generation's champion is the newest of the recent list
+            champions.append(run.hall.recent[-1]["key"])
+        # generations 1, 3, 5 (every 2nd, counting from 1), each its generation's champion
+        assert [g["key"] for g in run.hall.snapshots] == [champions[i] for i in (1, 3, 5)]
+        assert all(g in run.hall.candidates() for g in run.hall.snapshots)
+        result = run.result(0.0)
+    finally:
+        run.close()
+    # Snapshots only widen the choice: the population evolves exactly as without them.
+    assert histories(result) == histories(plain)
+    assert result.best_network == plain.best_network
+    assert result.post_evaluation.candidates >= plain.post_evaluation.candidates
+
+
+def test_snapshots_survive_a_checkpoint(tmp_path, small_neat_file, small_repertoire):
+    s = run_settings(small_neat_file, small_repertoire, task_dict(pool=0), generations=6)
+    s = EvolutionSettings(**{**s.as_dict(), "snapshot_every": 2})
+    straight = evolve(s, small_repertoire)
+    ckpt = tmp_path / "run.checkpoint.json"
+    interrupt(s, small_repertoire, ckpt, after=4)
+    resumed = evolve(s, small_repertoire, checkpoint=ckpt)
+    assert resumed.selected_network == straight.selected_network
+    assert resumed.post_evaluation.candidates == straight.post_evaluation.candidates
+    assert np.array_equal(resumed.post_evaluation.all_fitness, straight.post_evaluation.all_fitness)
+
+
+def test_hall_of_fame_snapshots_round_trip_and_old_halls_have_none():
+    hall = HallOfFame(2)
+    hall.update([{"key": 1, "fitness": 0.9}, {"key": 2, "fitness": 0.8}])
+    hall.snapshot({"key": 7, "fitness": 0.1})
+    hall.snapshot({"key": 7, "fitness": 0.1})  # an elite that wins twice is kept once
+    assert [g["key"] for g in hall.candidates()] == [1, 2, 7]
+    assert HallOfFame.from_dict(hall.to_dict()).snapshots == hall.snapshots
+    assert "snapshots" not in HallOfFame(2).to_dict()  # files of runs without them unchanged
+    assert HallOfFame.from_dict({"size": 2, "top": [], "recent": []}).snapshots == []
+
+
+def test_balanced_rule_weighs_own_and_validation_mazes_equally():
+    # columns: 2 rows in the task's own mazes, then 4 in validation mazes
+    fitness = [
+        [1.3, 1.3, 0.9, 0.9, 0.9, 0.9],  # own 1.3, validation 0.9: mean 1.033, balanced 1.1
+        [0.5, 0.5, 1.2, 1.2, 1.2, 1.2],  # own 0.5, validation 1.2: mean 0.967, balanced 0.85
+        [1.0, 1.0, 1.1, 1.1, 1.1, 1.1],  # own 1.0, validation 1.1: mean 1.067, balanced 1.05
+    ]
+    reached = np.ones((3, 6))
+    starts = np.zeros((6, 4))
+    task = _ScoredTask(fitness, reached)
+    assert post_evaluate(task, None, [0, 1, 2], starts, "mean", 1, validation=4).index == 2
+    post = post_evaluate(task, None, [0, 1, 2], starts, "balanced", 1, validation=4)
+    assert post.index == 0
+    assert post.fitness == pytest.approx(np.mean(fitness[0]))  # reported: the plain mean
+    # Without validation rows it is the mean rule.
+    assert post_evaluate(task, None, [0, 1, 2], starts, "balanced", 1, validation=0).index == 2
+
+
+def test_validation_mazes_may_change_when_a_run_resumes(
+    tmp_path, small_neat_file, small_repertoire
+):
+    s = run_settings(small_neat_file, small_repertoire, task_dict(pool=0), generations=4)
+    ckpt = tmp_path / "c.json"
+    with pytest.raises(Interrupted):
+        evolve(s, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    wider = EvolutionSettings(
+        **{**s.as_dict(), "task": task_dict(pool=0, post_mazes=3), "post_rule": "balanced"}
+    )
+    result = evolve(wider, small_repertoire, checkpoint=ckpt)
+    straight = evolve(wider, small_repertoire)
+    assert histories(result) == histories(straight)
+    # two own mazes x (nominal + 1 draw) + 3 validation mazes x 1 start
+    assert result.post_evaluation.episodes == 2 * 2 + 3
+    assert result.post_evaluation.rule == "balanced"
