@@ -85,7 +85,7 @@ class SimBridgeNode(Node):
                 self,
                 "episode_time",
                 spec.episode_time,
-                "episode length T (s; default: the robot's, 120 for 4WS, 30 for the hexapod)",
+                "episode length T (s; default: the robot's own, e.g. 120 for the 4WS robots)",
                 positive=True,
             )
             self.lockstep_timeout = finite_parameter(

@@ -24,7 +24,12 @@ from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.cli_support import OneLineParser, check_output_file, integer_in, report_unexpected
 from evorbc_ros.config import ConfigError
-from evorbc_ros.defaults import PAPER_WITH_FILE, no_shipped_controller, ships_controller
+from evorbc_ros.defaults import (
+    PAPER_WITH_FILE,
+    no_shipped_controller,
+    shipped_robots,
+    ships_controller,
+)
 from evorbc_ros.nodes.common import StartupError
 from evorbc_ros.repertoire import RepertoireError
 from evorbc_ros.robots import registry
@@ -52,13 +57,13 @@ def parse_args(argv=None) -> argparse.Namespace:
         choices=ROBOT_NAMES,
         default="",
         help="robot whose shipped controller runs (default: the arbitrator file's, else 4ws-5; "
-        "4ws-5 and hexapod ship one)",
+        f"{', '.join(shipped_robots())} ship one)",
     )
     p.add_argument(
         "--maze",
         default="",
         help=f"maze name ({', '.join(maze_names())}) or file "
-        "(default: the robot's: obstacle for 4WS robots, hexapod for the hexapod)",
+        "(default: the robot's own: obstacle for the 4WS robots)",
     )
     p.add_argument(
         "--arbitrator", default="", help="arbitrator file (default: the shipped one for --robot)"

@@ -47,8 +47,8 @@ ARGUMENTS = (
     Argument(
         "maze",
         "",
-        "maze name (obstacle, zigzag, baffles, corridors, gaps, hexapod) or maze YAML file; "
-        "empty: the robot's (obstacle, or hexapod for the hexapod)",
+        "maze name (a file of config/mazes, e.g. obstacle) or maze YAML file; "
+        "empty: the robot's own (its registration's maze: obstacle for the 4WS robots)",
     ),
     Argument(
         "mode", "lockstep", "lockstep (deterministic, as fast as the graph) or realtime (10 Hz)"
@@ -57,7 +57,7 @@ ARGUMENTS = (
     Argument(
         "arbitrator",
         "",
-        "arbitrator file (JSON); empty: the one shipped for robot (4ws-5 and hexapod ship one)",
+        "arbitrator file (JSON); empty: the one shipped for robot (4ws-5, hexapod and a1 ship one)",
     ),
     Argument(
         "paper",

@@ -2,14 +2,13 @@
 
 The package is the docs' example: ``evorbc_crab``, a 4WS body that steers all four wheels
 together, with its own settings files, declared through the ``evorbc.robots`` entry-point
-group in its ``pyproject.toml``. It is "installed" into a folder of its own that goes on
-``PYTHONPATH`` (and ``sys.path``), never into the venv, so no other test sees it: the
-package itself and the ``.dist-info`` folder pip would write, whose ``entry_points.txt``
-is made from the ``pyproject.toml`` (the build backend's job).
+group in its ``pyproject.toml``. pip installs it into a folder of its own
+(``--target``) that goes on ``PYTHONPATH`` (and ``sys.path``), never into the venv, so no
+other test sees it.
 """
 
-import shutil
-import tomllib
+import subprocess
+import sys
 from pathlib import Path
 
 from evorbc_ros.config import config_dir
@@ -108,22 +107,16 @@ def write_package(root: Path, module: str = MODULE) -> Path:
 
 
 def install(src: Path, site: Path) -> Path:
-    """Install the package in ``src`` into ``site`` (a folder for ``PYTHONPATH``)."""
-    meta = tomllib.loads((src / "pyproject.toml").read_text())["project"]
-    site.mkdir(parents=True, exist_ok=True)
-    for package in src.iterdir():
-        if (package / "__init__.py").is_file():
-            shutil.copytree(package, site / package.name)
-    info = site / f"{meta['name'].replace('-', '_')}-{meta['version']}.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text(
-        f"Metadata-Version: 2.1\nName: {meta['name']}\nVersion: {meta['version']}\n"
-    )
-    lines = []
-    for group, points in meta.get("entry-points", {}).items():
-        lines.append(f"[{group}]")
-        lines += [f"{name} = {value}" for name, value in points.items()]
-    (info / "entry_points.txt").write_text("\n".join(lines) + "\n")
+    """``pip install`` the package in ``src`` into ``site`` (a folder for ``PYTHONPATH``).
+
+    As a user installs a robot package (docs/your-robot.md): pip builds it with its own
+    build backend and writes its entry points; offline (``--no-index``, no build isolation,
+    the dependency on evorbc already met by this environment).
+    """
+    command = [sys.executable, "-m", "pip", "install", "--no-deps", "--no-build-isolation"]
+    command += ["--no-index", "--quiet", "--disable-pip-version-check", "--target", str(site)]
+    out = subprocess.run([*command, str(src)], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
     return site
 
 
