@@ -9,13 +9,15 @@ rclpy nor ``launch``, so the launch logic is tested wherever the project's tests
 Both fill in the same defaults: the robot's shipped controller when no arbitrator is given
 (its paper-protocol one with ``paper``; none for a 4WS type other than 4ws-5: the
 arbitrator node then refuses to start and says how to make one), the robot's maze,
-simulated time for the four evorbc nodes, the parameter files ``config/ros/*.yaml`` under
+the episode length the controller was evolved with (its file's task), simulated time for
+the four evorbc nodes, the parameter files ``config/ros/*.yaml`` under
 every node, and the ``robot`` parameter on the arbitrator, which refuses a controller for
 another robot.
 """
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -124,6 +126,26 @@ def shipped_arbitrator(robot: str, paper: bool = False) -> str:
     return str((paper_arbitrator if paper else default_arbitrator)(robot))
 
 
+def trained_episode_time(arbitrator: str) -> float | None:
+    """s, the episode length the controller in ``arbitrator`` was evolved with, if recorded.
+
+    A controller trained with longer episodes than its robot's default (the hexapod's
+    generalising controllers: 60 s, docs/generalisation.md) runs as long through the graph
+    as offline (``replay`` and ``evaluate`` use the file's task). None for a file that
+    records none, or that cannot be read: the arbitrator node reports a bad file itself.
+    """
+    if not arbitrator:
+        return None
+    try:
+        with open(arbitrator, encoding="utf-8") as f:
+            value = json.load(f)["evolution"]["task"]["episode_time"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+        return None
+    return float(value)
+
+
 def default_maze(robot: str) -> str:
     """The maze a robot runs in when none is named (its registration's: obstacle for 4WS)."""
     return registry.lookup(robot).maze
@@ -195,6 +217,7 @@ def sim_graph(
                         "start": start,
                         "seed": seed,
                         "result_file": result_file,
+                        "episode_time": trained_episode_time(arbitrator) or "",
                     }
                 ),
                 required=True,

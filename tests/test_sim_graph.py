@@ -51,6 +51,7 @@ def test_the_default_graph_runs_the_shipped_4ws_5_controller_in_obstacle():
             "gui": False,
             "start": "nominal",
             "seed": 0,
+            "episode_time": 120.0,  # the controller's training episodes
         },
     }
     assert {n.name: n.param_file for n in graph.nodes} == {
@@ -71,6 +72,27 @@ def test_the_hexapod_gets_its_shipped_controller_and_maze():
     assert p["sim_bridge"]["maze"] == "hexapod" and p["sim_bridge"]["robot"] == "hexapod"
     assert p["primitive_executor"]["robot"] == "hexapod"
     assert sim_graph(robot="hexapod", namespace="/robot1/").namespace == "robot1"
+
+
+def test_the_bridge_runs_episodes_as_long_as_the_controller_was_evolved_with(tmp_path):
+    import json
+
+    shipped = json.loads(Path(default_arbitrator("hexapod")).read_text())
+    longer = tmp_path / "hexapod-60s.json"
+    shipped["evolution"]["task"]["episode_time"] = 60.0
+    longer.write_text(json.dumps(shipped))
+    bridge = params(sim_graph(robot="hexapod", arbitrator=str(longer)))["sim_bridge"]
+    assert bridge["episode_time"] == 60.0
+    # A file that records no training task, or none that can be read: the robot's default
+    # (the bridge's own parameter), and the arbitrator node reports a bad file.
+    del shipped["evolution"]
+    bare = tmp_path / "bare.json"
+    bare.write_text(json.dumps(shipped))
+    for arbitrator in (bare, tmp_path / "missing.json"):
+        assert (
+            "episode_time"
+            not in params(sim_graph("hexapod", arbitrator=str(arbitrator)))["sim_bridge"]
+        )
 
 
 def test_a_robot_without_a_shipped_controller_leaves_the_arbitrator_to_refuse():
@@ -95,6 +117,7 @@ def test_launch_arguments_are_parsed_with_one_line_errors():
         "gui": True,
         "start": "nominal",
         "seed": 7,
+        "episode_time": 120.0,
     }
     assert graph.namespace == "r1"
     for values, message in [
