@@ -157,10 +157,20 @@ def _tiny_network():
     }
 
 
+@pytest.mark.parametrize(
+    "variant",
+    [
+        {"pool": 0},  # fresh draws
+        {"pool": 6},  # a pool sampled by generation
+        {"perturb": "realistic"},  # per-episode worlds seeded by generation
+        {"distance": "path"},  # path-length fitness
+    ],
+    ids=["fresh", "pool", "perturbed", "path"],
+)
 def test_every_genome_sees_the_same_draw_and_resume_is_exact(
-    tmp_path, small_neat_file, small_repertoire
+    tmp_path, small_neat_file, small_repertoire, variant
 ):
-    s = run_settings(small_neat_file, small_repertoire, task_dict(pool=0))
+    s = run_settings(small_neat_file, small_repertoire, task_dict(**variant))
     straight = evolve(s, small_repertoire)
     ckpt = tmp_path / "run.checkpoint.json"
     interrupt(s, small_repertoire, ckpt, after=2)
