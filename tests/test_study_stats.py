@@ -111,3 +111,39 @@ def test_adjacent_pairs_and_best_and_correlation():
     assert best_claim.verdict == HOLDS
     assert wrong_best.verdict == FAILS
     assert "eval_time 2.0" in wrong_best.comparisons[0].note
+
+
+def test_best_needs_significance_and_runs():
+    """A setting that leads by noise, or has no runs, is inconclusive, not holds or fails."""
+    rng = np.random.default_rng(5)
+    noisy = [
+        ({"bin_size": 0.04}, 1.20 + 0.1 * rng.standard_normal(5)),
+        ({"bin_size": 0.02}, 1.19 + 0.1 * rng.standard_normal(5)),
+        ({"bin_size": 0.10}, 0.50 + 0.1 * rng.standard_normal(5)),
+    ]
+    claims = [
+        {"claim": "leads", "test": "best", "a": {"bin_size": 0.04}},
+        {"claim": "second", "test": "best", "a": {"bin_size": 0.02}},
+        {"claim": "worst", "test": "best", "a": {"bin_size": 0.10}},
+        {"claim": "never run", "test": "best", "a": {"bin_size": 0.01}},
+    ]
+    leads, second, worst, never = evaluate_claims(claims, noisy)
+    assert leads.verdict == INCONCLUSIVE and second.verdict == INCONCLUSIVE
+    assert worst.verdict == FAILS  # the leader is far above it
+    assert never.verdict == INCONCLUSIVE and never.comparisons[0].note == "no runs of this setting"
+    top = leads if leads.comparisons[0].means[0] > second.comparisons[0].means[0] else second
+    assert top.comparisons[0].note.startswith("the highest mean of all settings; the runner-up")
+
+
+def test_same_with_a_large_unproven_effect_is_inconclusive():
+    # 3 against 3 runs, all of a above all of b: A12 1.0, yet the exact p is 0.1.
+    samples = [
+        ({"mapping": "polar"}, np.array([1.30, 1.31, 1.32])),
+        ({"mapping": "cartesian"}, np.array([1.20, 1.21, 1.22])),
+    ]
+    claim = {"claim": "c", "test": "mann-whitney", "a": {"mapping": "polar"},
+             "b": {"mapping": "cartesian"}, "expect": "same"}  # fmt: skip
+    (result,) = evaluate_claims([claim], samples)
+    comp = result.comparisons[0]
+    assert comp.p > 0.05 and comp.effect == 1.0
+    assert result.verdict == INCONCLUSIVE

@@ -160,7 +160,7 @@ def _markdown(study, settings: list[SettingResults], keys, claims, drawn, result
         f"[config/studies/{Path(study.source).name}](../../config/studies/{Path(study.source).name})).",
         f"* Runs finished: {proto['runs']}, {_span(proto['min_seeds'], proto['max_seeds'])} "
         f"seeds per setting (the full protocol has {study.seeds}).",
-        f"* NEAT generations per run: {gens} (Table I: the study file's).",
+        f"* NEAT generations per run: {gens}{_full_generations(study, settings)}.",
         "* Each run: its own repertoire (EvoRBC) and arbitrator, or a standard-NEAT "
         "controller, seeded by the run's seed; the figure is the run's highest training "
         "fitness (eq. 5, mean over the five mazes; 1 or more: every target reached).",
@@ -211,8 +211,9 @@ def _markdown(study, settings: list[SettingResults], keys, claims, drawn, result
         f"with Holm-Bonferroni within each family of comparisons, significance at "
         f"{ALPHA}. Effect sizes: Vargha-Delaney A12 (the chance that a run of the first "
         "setting beats one of the second; 0.5 = no effect), epsilon-squared, Pearson's r. "
-        "A claim of *no difference* holds when no test finds one; with few runs that is "
-        "weak evidence, as the verdicts say.",
+        "A claim of *no difference* holds when no test finds one and no effect is large "
+        "(A12 within 0.29-0.71); with few runs that is weak evidence. A claim that a "
+        "setting is *best* holds only if it leads and is significantly above the runner-up.",
         "",
     ]
     lines += _claims_table(claims)
@@ -264,6 +265,8 @@ def _costs(study: Study, settings: list[SettingResults]) -> list[str]:
         wall = statistics.median(r.record["seconds"] for r in s.runs)
         cpu = statistics.median(r.record["cpu_seconds"] for r in s.runs)
         gens = s.runs[0].record["settings"].get("generations")
+        summary = s.runs[0].record.get("summary", {})
+        gens = summary.get("generations") or s.runs[0].record["settings"].get("generations")
         scale = _full_cpu(s, {**s.runs[0].record, "cpu_seconds": 1.0})
         full_cpu += cpu * scale * study.seeds
         machine = s.runs[0].record.get("machine", "")
@@ -271,20 +274,31 @@ def _costs(study: Study, settings: list[SettingResults]) -> list[str]:
             f"| {figures.setting_label(s.values, list(study.grid))} | {wall / 60:.1f} | "
             f"{cpu / 60:.1f} | {gens} | {cpu * scale / 60:.1f} | {machine} |"
         )
+    measured, total = len(rows), len(settings)
+    if measured and measured < total:
+        # Settings without a finished run yet are costed at the measured settings' mean.
+        full_cpu *= total / measured
+    partial = (
+        f" ({measured} of {total} settings measured; the others are taken at the measured "
+        "settings' mean)"
+        if measured < total
+        else ""
+    )
     out += [
-        "Measured per run (median over the setting's runs; one numba thread per run, two runs "
-        "at once on a 2-core VM shared with other work, so wall times are upper bounds). "
-        "The full-protocol column scales the CPU time by the generations of the full "
-        "protocol (the repertoire is a few seconds of it).",
+        "Measured per run (median over the setting's runs; one numba thread per run, on a "
+        "machine shared with other work, so wall times are upper bounds; the CPU time is "
+        "the run's own). The full-protocol column scales the CPU time by the generations "
+        "of the full protocol (standard NEAT's equal-budget generations included; the "
+        "repertoire is a few seconds of it).",
         "",
         "| setting | wall min/run | CPU min/run | generations | CPU min/run, full | machine |",
         "|---|---|---|---|---|---|",
         *rows,
         "",
         f"The full protocol ({study.seeds} seeds per setting) is about {full_cpu / 3600:.0f} "
-        "CPU hours. Runs are independent and take one core each, so on a cluster of N "
-        "machines with M cores it takes about that divided by N x M (plus the longest single "
-        "run):",
+        f"CPU hours{partial}. Runs are independent and take one core each, so on a cluster "
+        "of N machines with M cores it takes about that divided by N x M, or the longest "
+        "single run if that is longer:",
         "",
         "| machines x cores | wall time |",
         "|---|---|",
@@ -297,10 +311,40 @@ def _costs(study: Study, settings: list[SettingResults]) -> list[str]:
 
 
 def _full_cpu(setting: SettingResults, record: dict) -> float:
-    """A run's CPU seconds scaled to the full protocol's generations (the study file's)."""
+    """A run's CPU seconds scaled to the full protocol's generations (the study file's).
+
+    A standard-NEAT run at equal budget ran more generations than asked (the repertoire's
+    evaluations as extra generations, ``summary.generations``); the extra is the same at
+    any length, so the full run has it too.
+    """
     done = record["settings"].get("generations")
     full = setting.values.get("generations")
-    return record["cpu_seconds"] * (full / done if done and full else 1.0)
+    if not (done and full):
+        return record["cpu_seconds"]
+    extra = (record.get("summary", {}).get("generations") or done) - done
+    return record["cpu_seconds"] * (full + extra) / (done + extra)
+
+
+def _full_generations(study: Study, settings: list[SettingResults]) -> str:
+    """`` (the full protocol: 1000, ...)`` for the protocol line of the report."""
+    full = sorted({s.values.get("generations") for s in settings} - {None})
+    extra = sorted(
+        {
+            r.record["summary"]["generations"] - r.record["settings"]["generations"]
+            for s in settings
+            for r in s.runs
+            if r.record.get("summary", {}).get("generations")
+            and r.record["settings"].get("generations")
+        }
+        - {0}
+    )
+    text = f" (the full protocol: {', '.join(map(str, full))})" if full else ""
+    if extra:
+        text += (
+            f"; standard NEAT at equal budget runs {', '.join(map(str, extra))} more, "
+            "for the repertoire's evaluations"
+        )
+    return text
 
 
 def default_out() -> Path:
