@@ -59,3 +59,25 @@ def test_an_unreachable_cluster_is_one_line(tmp_path):
     lines = result.stderr.strip().splitlines()
     assert lines[-1].startswith("evorbc-study: error: --address 127.0.0.1:")
     assert "cannot connect to the Ray cluster" in lines[-1]
+
+
+@pytest.mark.slow
+def test_spread_runs_queue_one_at_a_time_with_results_identical_to_a_serial_run(
+    cluster, tmp_path, serial_results
+):
+    """``--spread 1``: the runs ask Ray for no CPU and are handed out one at a time (the
+    second from the queue when the first ends), each with the cluster's address for its
+    simulations (a no-op for the 2WS kernel); the results are the serial runner's."""
+    study = write_tiny_study(tmp_path)
+    results = tmp_path / "spread"
+    result = subprocess.run(
+        study_command("run", study, "--results", results, "--address", cluster.address,
+                      "--spread", "1"),
+        capture_output=True, text=True, timeout=600, env=cluster.env,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert "study tiny: 2 done, 0 running, 0 left" in result.stderr
+    # The first run's end hands out the second: never two at once.
+    assert "study tiny: 1 done, 1 running, 0 left" in result.stderr
+    assert "2 running" not in result.stderr
+    assert results_contents(results) == results_contents(serial_results)

@@ -152,8 +152,16 @@ def example_repertoires(
     save_figure(fig, path)
 
 
-def bin_time_heatmaps(settings: list[SettingResults], path: str | os.PathLike) -> None:
-    """Fig. 12: mean repertoire size (left) and mean highest fitness (right) per cell."""
+def bin_time_grid(
+    settings: list[SettingResults],
+) -> tuple[list[float], list[float], np.ndarray, np.ndarray]:
+    """The cells of Fig. 12.
+
+    Returns:
+        ``bins`` (m, ascending), ``times`` (s, ascending), and per cell ``(len(times),
+        len(bins))`` the mean repertoire size and the mean highest fitness of its runs;
+        NaN for a cell left out of the grid or without finished runs.
+    """
     bins = _ordered({s.values["bin_size"] for s in settings})
     times = _ordered({s.values["eval_time"] for s in settings})
     size = np.full((len(times), len(bins)), np.nan)
@@ -163,6 +171,12 @@ def bin_time_heatmaps(settings: list[SettingResults], path: str | os.PathLike) -
             i, j = times.index(s.values["eval_time"]), bins.index(s.values["bin_size"])
             size[i, j] = np.nanmean(s.summary("repertoire.count"))
             fit[i, j] = s.best.mean()
+    return bins, times, size, fit
+
+
+def bin_time_heatmaps(settings: list[SettingResults], path: str | os.PathLike) -> None:
+    """Fig. 12: mean repertoire size (left) and mean highest fitness (right) per cell."""
+    bins, times, size, fit = bin_time_grid(settings)
     fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.4), layout="constrained")
     for ax, data, label, fmt, norm in (
         (axes[0], size, "primitives in the repertoire", "{:.0f}", LogNorm()),
