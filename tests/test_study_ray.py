@@ -46,6 +46,8 @@ def test_a_study_survives_losing_a_node_with_results_identical_to_a_serial_run(
     assert "study tiny: 2 done, 0 running, 0 left" in out
     logs = [p.read_text() for p in results.rglob("run.log")]
     assert any(log.count("$ evorbc-evolve arbitrator") == 2 for log in logs)  # retried
+    # ... from its checkpoint, not from the start.
+    assert any("resuming from the checkpoint: generations 1-" in log for log in logs)
     assert results_contents(results) == results_contents(serial_results)
 
 

@@ -122,6 +122,8 @@ def test_a_killed_study_resumes_to_the_uninterrupted_results(serial_results, tmp
     assert resumed.returncode == 0, resumed.stderr
     logs = [p.read_text() for p in results.rglob("run.log")]
     assert any(log.count("$ evorbc-evolve arbitrator") == 2 for log in logs)  # ran again
+    # ... from its checkpoint, not from the start.
+    assert any("resuming from the checkpoint: generations 1-" in log for log in logs)
     assert results_contents(results) == results_contents(serial_results)
 
 

@@ -64,7 +64,9 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         help="keep the finished run's checkpoint, so that the same command with a larger "
         "--generations continues it (e.g. look at 300 generations, then go on to 1000)",
     )
-    p.add_argument("--quiet", action="store_true", help="no per-generation lines")
+    p.add_argument(
+        "--quiet", action="store_true", help="no per-generation lines (a resume is still said)"
+    )
     add_workers_option(p)
 
 
@@ -120,16 +122,17 @@ class _GenerationPrinter:
         self.recent: deque[float] = deque(maxlen=10)  # s per generation
 
     def __call__(self, stats, settings) -> None:
-        if self.quiet:
-            return
         if not self.announced:
             self.announced = True
+            # Said even with --quiet: one line that a log (a study's run.log) keeps.
             if stats.generation > 0:  # the first generation run here was not the run's first
                 print(
                     f"resuming from the checkpoint: generations 1-{stats.generation} of "
                     f"{self.total} are done",
                     file=sys.stderr,
                 )
+        if self.quiet:
+            return
         self.recent.append(stats.seconds)
         print(
             f"generation {stats.generation + 1:>4}/{self.total}  best {stats.best:6.3f}  "
