@@ -7,7 +7,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.evorbc-installed
 OUT    ?= demo-output
 
-.PHONY: demo demo-hexapod demo-a1 demo-repertoire demo-evolve test test-fast lint bench clean
+.PHONY: demo demo-hexapod demo-a1 demo-repertoire demo-evolve test test-fast lint bench bench-generalise clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -66,6 +66,12 @@ bench: $(STAMP)
 	$(PY) bench/bench_repertoire.py
 	$(PY) bench/bench_arbitrator.py
 	$(PY) bench/bench_ros.py
+
+# Generated-maze training and held-out evaluation (docs/performance.md): about 20 minutes.
+bench-generalise: $(STAMP)
+	$(PY) bench/bench_training_mazes.py
+	$(PY) bench/bench_training_mazes_legged.py --episode-time 60 --generations 2
+	$(PY) bench/bench_evaluate.py
 
 clean:
 	rm -rf $(VENV) $(OUT) build *.egg-info

@@ -9,12 +9,13 @@ prints episodes per second, with the episodes alone and the measures apart:
   random starts each, without and with the ``realistic`` perturbation set; the compiled
   kernel runs every episode of a suite in one parallel call;
 * the hexapod on its maze, ``--hexapod-starts`` random starts, on every core (PyBullet
-  workers), without and with ``realistic``.
+  workers), without and with ``realistic``; then on ``--hexapod-generated`` held-out
+  hexapod mazes with the 60 s episodes its generalisation runs use (docs/generalisation.md).
 
 Also the whole command in a fresh process (imports, maze generation, report, no picture).
 
 Run: ``.venv/bin/python bench/bench_evaluate.py [--starts 20] [--generated 50]
-[--hexapod-starts 8]``.
+[--hexapod-starts 8] [--hexapod-generated 2]``.
 """
 
 from __future__ import annotations
@@ -75,21 +76,26 @@ def report(label: str, n: int, total: float, episodes: float, cycles: int) -> No
     )
 
 
+def held_out_files(robot: str, n: int, folder: str) -> tuple[str, ...]:
+    """The first ``n`` held-out mazes of ``robot``, saved as maze files in ``folder``."""
+    t = time.perf_counter()
+    spec = spec_for_robot(robot)
+    files = []
+    for k in range(n):
+        maze = generate_maze(spec, HELD_OUT_SEED, k).maze
+        files.append(str(Path(folder) / f"{maze.name}.yaml"))
+        save_maze(maze, files[-1])
+    print(f"generating {n} held-out {robot} mazes (each proven): {time.perf_counter() - t:.1f} s")
+    return tuple(files)
+
+
 def four_ws(starts: int, generated: int) -> None:
     # The paper-protocol controllers (their sensor layouts below): the recorded figures'.
     arb = ArbitratorFile.load(paper_arbitrator("4ws-5"))
     repertoire = Repertoire.load(default_repertoire("4ws-5"))
     realistic = load_perturbations("realistic")
     with tempfile.TemporaryDirectory() as tmp:
-        t = time.perf_counter()
-        spec = spec_for_robot("4ws-5")
-        files = []
-        for k in range(generated):
-            maze = generate_maze(spec, HELD_OUT_SEED, k).maze
-            files.append(str(Path(tmp) / f"{maze.name}.yaml"))
-            save_maze(maze, files[-1])
-        made = time.perf_counter() - t
-        print(f"generating {generated} held-out 4WS mazes (each proven): {made:.1f} s")
+        files = held_out_files("4ws-5", generated, tmp)
         suites = {"paper mazes": PAPER, f"{generated} held-out mazes": tuple(files)}
         for name, mazes in suites.items():
             task = make_task(MazeTaskSettings(mazes, 120.0, 1, "sensors/4ws.yaml"), "4ws-5")
@@ -100,7 +106,7 @@ def four_ws(starts: int, generated: int) -> None:
                 report(label, len(mazes) * starts, total, alone, cycles)
 
 
-def hexapod(starts: int) -> None:
+def hexapod(starts: int, generated: int) -> None:
     arb = ArbitratorFile.load(paper_arbitrator("hexapod"))
     repertoire = Repertoire.load(default_repertoire("hexapod"))
     task = make_task(MazeTaskSettings(("hexapod",), 30.0, 1, "sensors/hexapod.yaml"), "hexapod")
@@ -113,6 +119,19 @@ def hexapod(starts: int) -> None:
             report(label, starts, total, alone, cycles)
     finally:
         task.close()
+    if not generated:
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        files = held_out_files("hexapod", generated, tmp)
+        # 60 s episodes, as the hexapod's generalisation runs; the workers start and build
+        # each maze's world in the timed call (an evaluation does that once per maze).
+        task = make_task(MazeTaskSettings(files, 60.0, 1, "sensors/hexapod.yaml"), "hexapod")
+        try:
+            total, alone, cycles = timed_suite(task, arb, repertoire, starts, NONE)
+            label = f"hexapod, {generated} held-out mazes x {starts}, 60 s ({task.workers} workers)"
+            report(label, generated * starts, total, alone, cycles)
+        finally:
+            task.close()
 
 
 def command(args: list[str]) -> float:
@@ -128,10 +147,11 @@ def main() -> None:
     parser.add_argument("--starts", type=int, default=20)
     parser.add_argument("--generated", type=int, default=50)
     parser.add_argument("--hexapod-starts", type=int, default=8)
+    parser.add_argument("--hexapod-generated", type=int, default=2)
     args = parser.parse_args()
     print(f"machine: {machine()}, load average {os.getloadavg()[0]:.1f}")
     four_ws(args.starts, args.generated)
-    hexapod(args.hexapod_starts)
+    hexapod(args.hexapod_starts, args.hexapod_generated)
     for cli in (
         ["evaluate", "--paper", "--starts", str(args.starts)],
         ["evaluate", "--paper", "--generated", str(args.generated), "--starts", str(args.starts)],
