@@ -346,3 +346,45 @@ def test_perturbed_training_needs_a_simulation_that_takes_perturbations():
     task.perturbations_applied = ()  # as a robot's task's task without perturbed worlds
     with pytest.raises(ConfigError, match=r"t\.yaml: training: perturb realistic: 4ws-5's"):
         task.start_training("4ws-5", 1, source="t.yaml")
+
+
+@pytest.mark.slow
+def test_hexapod_generated_maze_training_resumes_exactly(tmp_path):
+    """PyBullet episodes in fresh generated mazes, 2 workers: an interrupted run resumes
+    to the uninterrupted run's history and genomes (docs/design.md section 22)."""
+    from evorbc_ros.arbitrator import ArbitratorFile
+    from evorbc_ros.config import config_dir
+    from evorbc_ros.defaults import default_arbitrator, default_repertoire
+    from evorbc_ros.repertoire import Repertoire
+
+    shipped = (config_dir() / "neat" / "hexapod.ini").read_text()
+    neat = tmp_path / "small.ini"
+    neat.write_text(shipped.replace("pop_size              = 150", "pop_size              = 24"))
+    assert "pop_size              = 24" in neat.read_text()
+    repertoire = Repertoire.load(default_repertoire("hexapod"))
+    # The shipped controller's own sensor layout, whichever ships.
+    sensors = ArbitratorFile.load(default_arbitrator("hexapod")).evolution["task"]["sensors"]
+    task = {
+        "mazes": ["hexapod"],
+        "episode_time": 1.0,
+        "samples_per_maze": 1,
+        "sensors": sensors,
+        "training": {"generated": 1, "starts": 1, "pool": 0, "maze_seed": 5, "post_mazes": 1},
+    }
+    s = EvolutionSettings(
+        kind="evorbc", robot="hexapod", generations=3, seed=3, neat_file=str(neat),
+        neat_sha256=file_sha256(neat), task=task, mapping="polar",
+        repertoire_fingerprint=repertoire.fingerprint(), hall_of_fame=2, post_samples=1,
+    )  # fmt: skip
+    straight = evolve(s, repertoire, workers=2)
+    ckpt = tmp_path / "run.checkpoint.json"
+    polls = []
+    with pytest.raises(Interrupted):
+        evolve(
+            s, repertoire, checkpoint=ckpt, checkpoint_every=100, workers=2,
+            should_stop=lambda: polls.append(1) or len(polls) == 1,
+        )  # fmt: skip
+    resumed = evolve(s, repertoire, checkpoint=ckpt, workers=2)
+    assert histories(resumed) == histories(straight)
+    assert resumed.best_network == straight.best_network
+    assert resumed.selected_network == straight.selected_network
