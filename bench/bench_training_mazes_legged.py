@@ -122,7 +122,9 @@ def generation_seconds(
 def small_population(robot: str, population: int, folder: Path) -> Path:
     """The robot's shipped NEAT settings with ``pop_size`` = ``population``."""
     shipped = config_dir() / lookup(robot).settings.neat
-    text = re.sub(r"(?m)^pop_size\s*=.*$", f"pop_size = {population}", shipped.read_text())
+    text, n = re.subn(r"(?m)^pop_size\s*=.*$", f"pop_size = {population}", shipped.read_text())
+    if n != 1:  # else the run would use the shipped population and print the wrong one
+        raise SystemExit(f"{shipped}: expected one pop_size line, found {n}")
     path = folder / "neat.ini"
     path.write_text(text)
     return path
@@ -139,6 +141,8 @@ def main() -> int:
     p.add_argument("--episode-time", type=float, default=20.0, help="s per episode")
     p.add_argument("--workers", type=int, default=1, help="PyBullet worker processes")
     args = p.parse_args()
+    if args.k < 1 or args.draws < 1 or args.generations < 1:
+        p.error("--k, --draws and --generations must be at least 1")
     print(machine())
     repertoire = Repertoire.load(default_repertoire(args.robot))
 

@@ -208,8 +208,10 @@ def test_progress_says_when_a_run_resumes_from_its_checkpoint(capsys):
     from offline_evolution.arbitrator.evolve import GenerationStats
     from offline_evolution.commands.arbitrator import _GenerationPrinter
 
-    def lines(first_generation):
-        printer = _GenerationPrinter(quiet=False, total=655)
+    def lines(first_generation, quiet=False):
+        printer = _GenerationPrinter(quiet=quiet, total=655)
+        if first_generation:  # what evolve() calls on restoring a checkpoint
+            printer.resumed(first_generation)
         for g in (first_generation, first_generation + 1):
             printer(GenerationStats(g, 0.4, 0.1, 0.4, 3, 26.0, 25.0, 0), None)
         return capsys.readouterr().err.splitlines()
@@ -218,6 +220,8 @@ def test_progress_says_when_a_run_resumes_from_its_checkpoint(capsys):
     assert [line.split()[1] for line in fresh] == ["1/655", "2/655"]
     assert resumed[0] == "resuming from the checkpoint: generations 1-100 of 655 are done"
     assert [line.split()[1] for line in resumed[1:]] == ["101/655", "102/655"]
+    # --quiet keeps the resume, and only it.
+    assert lines(100, quiet=True) == resumed[:1]
 
 
 def test_the_eta_is_not_thrown_by_one_slow_generation(capsys):

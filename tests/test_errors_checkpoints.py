@@ -90,10 +90,17 @@ def test_a_kept_arbitrator_checkpoint_is_complete_and_resumes_to_the_same_result
 
     s = settings(small_neat_file, generations=2, repertoire=small_repertoire)
     ckpt = tmp_path / "a.checkpoint.json"
-    first = evolve(s, small_repertoire, checkpoint=ckpt, keep_checkpoint=True)
+    resumes = []
+    first = evolve(
+        s, small_repertoire, checkpoint=ckpt, keep_checkpoint=True, on_resume=resumes.append
+    )
+    assert resumes == []  # a fresh run
     data = json.loads(ckpt.read_text())
     assert data["population"]["generation"] == 2 and len(data["history"]) == 2
-    again = evolve(s, small_repertoire, checkpoint=ckpt, keep_checkpoint=True)
+    again = evolve(
+        s, small_repertoire, checkpoint=ckpt, keep_checkpoint=True, on_resume=resumes.append
+    )
+    assert resumes == [2]  # said although only the post-evaluation was left
     same(first, again)
     assert again.selected_network == first.selected_network
     evolve(s, small_repertoire, checkpoint=ckpt)

@@ -96,3 +96,38 @@ def test_selection_pools_every_cycle_of_every_runs_nominal_replays(serial_result
         # Every chosen displacement is one of the run's primitives.
         assert all(np.any(np.all(rep.behaviour == row, axis=1)) for row in c)
         assert r == pytest.approx(np.max(np.abs(rep.behaviour)))
+
+
+def _costed(setting_id, approach, cpu, seconds, done, ran, evolution_seconds):
+    run = FinishedRun(
+        None,
+        {
+            "cpu_seconds": cpu,
+            "seconds": seconds,
+            "settings": {"generations": done},
+            "summary": {"generations": ran},
+        },
+    )
+    run.arbitrator_data = {"evolution": {"seconds": evolution_seconds}}  # no file needed
+    values = {"approach": approach, "generations": 1000}
+    return SettingResults(setting_id, values, [run])
+
+
+def test_full_protocol_cost_scales_the_evolution_only_and_imputes_by_approach():
+    from offline_evolution.study.report import _fixed_share, _full_cpu, _imputed
+
+    # EvoRBC: half its wall time outside evolution (a PyBullet repertoire), 300 of 1000.
+    evo = _costed("e", "evorbc", cpu=100.0, seconds=200.0, done=300, ran=300,
+                  evolution_seconds=100.0)  # fmt: skip
+    assert _fixed_share(evo.runs[0]) == pytest.approx(0.5)
+    assert _full_cpu(evo, evo.runs[0].record, 0.5) == pytest.approx(100 * (0.5 + 0.5 * 1000 / 300))
+    # Standard NEAT at equal budget: 300 asked, 325 run; the full run is 1025 generations.
+    std = _costed("s", "standard", cpu=65.0, seconds=65.0, done=300, ran=325,
+                  evolution_seconds=65.0)  # fmt: skip
+    assert _fixed_share(std.runs[0]) == 0.0
+    assert _full_cpu(std, std.runs[0].record) == pytest.approx(65 * 1025 / 325)
+    # A setting without runs is costed at its own approach's measured mean.
+    missing = SettingResults("m", {"approach": "standard", "generations": 1000})
+    per_run = {"e": 500.0, "s": 200.0}
+    assert _imputed(missing, [evo, std, missing], per_run) == 200.0
+    assert _imputed(evo, [evo, std, missing], per_run) == 500.0

@@ -132,7 +132,42 @@ def test_best_needs_significance_and_runs():
     assert worst.verdict == FAILS  # the leader is far above it
     assert never.verdict == INCONCLUSIVE and never.comparisons[0].note == "no runs of this setting"
     top = leads if leads.comparisons[0].means[0] > second.comparisons[0].means[0] else second
-    assert top.comparisons[0].note.startswith("the highest mean of all settings; the runner-up")
+    assert top.comparisons[0].note.startswith("the highest mean, not significantly above 1 of 2")
+    assert worst.comparisons[0].note.endswith("is significantly above it")
+
+
+def test_best_goes_by_ranks_against_every_other_setting():
+    # "outlier" has the highest mean from one run alone; "steady" beats it in ranks.
+    samples = [
+        ({"s": "outlier"}, np.array([0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 9.0])),
+        ({"s": "steady"}, np.array([1.0, 1.1, 1.2, 1.0, 1.1, 1.2, 1.0, 1.1, 1.2])),
+        ({"s": "low"}, np.array([0.1, 0.2, 0.3, 0.1, 0.2, 0.3, 0.1, 0.2, 0.3])),
+    ]
+    claims = [{"claim": c, "test": "best", "a": {"s": c}} for c in ("outlier", "steady", "low")]
+    outlier, steady, low = evaluate_claims(claims, samples)
+    assert outlier.verdict == FAILS  # steady is significantly above it in ranks
+    assert steady.verdict == INCONCLUSIVE  # above in ranks, but not the highest mean
+    assert low.verdict == FAILS
+    # Leading in mean and significantly above every other setting: holds.
+    clean = [({"s": "a"}, np.array([2.0, 2.1, 2.2, 2.3, 2.4])), *samples[1:]]
+    (a,) = evaluate_claims([{"claim": "a", "test": "best", "a": {"s": "a"}}], clean)
+    assert a.verdict == HOLDS and "the weakest win: s steady" in a.comparisons[0].note
+
+
+@pytest.mark.parametrize(("a12", "verdict"), [(0.71, INCONCLUSIVE), (0.29, INCONCLUSIVE)])
+def test_the_large_effect_threshold_is_symmetric(a12, verdict):
+    # 10 against 10 runs with U = 71 (or 29): A12 exactly 0.71 (0.29), not significant.
+    a = np.arange(10, dtype=float)
+    b = a - 2.5  # a beats b in 72 of the 100 pairs
+    b[-1] = 7.5  # ... and in 71: a12 0.71
+    samples = (
+        [({"m": "a"}, a), ({"m": "b"}, b)] if a12 > 0.5 else [({"m": "a"}, b), ({"m": "b"}, a)]
+    )
+    claim = {"claim": "c", "test": "mann-whitney", "a": {"m": "a"}, "b": {"m": "b"},
+             "expect": "same"}  # fmt: skip
+    (result,) = evaluate_claims([claim], samples)
+    assert result.comparisons[0].effect == pytest.approx(a12)
+    assert result.comparisons[0].p > 0.05 and result.verdict == verdict
 
 
 def test_same_with_a_large_unproven_effect_is_inconclusive():

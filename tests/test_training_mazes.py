@@ -172,6 +172,9 @@ def test_every_genome_sees_the_same_draw_and_resume_is_exact(
 ):
     s = run_settings(small_neat_file, small_repertoire, task_dict(**variant))
     straight = evolve(s, small_repertoire)
+    if variant != {"pool": 0}:  # the variant changes the run, so it was taken into account
+        fresh = run_settings(small_neat_file, small_repertoire, task_dict(pool=0))
+        assert histories(evolve(fresh, small_repertoire)) != histories(straight)
     ckpt = tmp_path / "run.checkpoint.json"
     interrupt(s, small_repertoire, ckpt, after=2)
     resumed = evolve(s, small_repertoire, checkpoint=ckpt)

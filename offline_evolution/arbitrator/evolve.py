@@ -474,6 +474,7 @@ def evolve(
     repertoire_source: str = "the repertoire",
     keep_checkpoint: bool = False,
     task: ArbitratorTask | None = None,
+    on_resume: Callable[[int], None] | None = None,
 ) -> EvolutionResult:
     """Run NEAT on a task to the last generation (exported as ``evolve_arbitrator``).
 
@@ -494,6 +495,9 @@ def evolve(
         task: the task to evolve on (any :class:`~offline_evolution.task_protocol.
             ArbitratorTask`); by default the maze task ``settings.task`` describes for
             ``settings.robot``. A task given here is left open for the caller.
+        on_resume: called with the generations already done when the run resumes from
+            ``checkpoint`` (before anything runs; also when only the post-evaluation is
+            left).
 
     Raises:
         RepertoireError: the repertoire was evolved for another simulated robot.
@@ -504,6 +508,8 @@ def evolve(
         elapsed = 0.0
         if checkpoint is not None and os.path.exists(checkpoint):
             elapsed = run.restore(checkpoint)
+            if on_resume is not None:
+                on_resume(run.generation)
         start = time.perf_counter() - elapsed
         saved = run.generation
         while not run.finished:

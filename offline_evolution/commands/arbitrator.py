@@ -118,19 +118,16 @@ class _GenerationPrinter:
     def __init__(self, quiet: bool, total: int) -> None:
         self.quiet = quiet
         self.total = total
-        self.announced = False
         self.recent: deque[float] = deque(maxlen=10)  # s per generation
 
+    def resumed(self, done: int) -> None:
+        """Say that the run resumes; even with --quiet: a log (a study's run.log) keeps it."""
+        print(
+            f"resuming from the checkpoint: generations 1-{done} of {self.total} are done",
+            file=sys.stderr,
+        )
+
     def __call__(self, stats, settings) -> None:
-        if not self.announced:
-            self.announced = True
-            # Said even with --quiet: one line that a log (a study's run.log) keeps.
-            if stats.generation > 0:  # the first generation run here was not the run's first
-                print(
-                    f"resuming from the checkpoint: generations 1-{stats.generation} of "
-                    f"{self.total} are done",
-                    file=sys.stderr,
-                )
         if self.quiet:
             return
         self.recent.append(stats.seconds)
@@ -158,13 +155,15 @@ def _run(args, settings, every: int, repertoire, checkpoint: Path):
 
     if args.restart:
         restart_from_scratch(checkpoint, CHECKPOINT_KIND, "NEAT evolution checkpoint")
+    printer = _GenerationPrinter(args.quiet, settings.generations)
     with running("generation", "generation") as stop:
         return evolve(
             settings,
             repertoire,
             checkpoint=checkpoint,
             checkpoint_every=every,
-            progress=_GenerationPrinter(args.quiet, settings.generations),
+            progress=printer,
+            on_resume=printer.resumed,
             should_stop=stop,
             workers=args.workers or None,
             repertoire_source=args.repertoire if repertoire else "the repertoire",

@@ -258,29 +258,26 @@ def _claims_table(claims: list[ClaimResult]) -> list[str]:
 def _costs(study: Study, settings: list[SettingResults]) -> list[str]:
     """Measured cost per run and the projected cost of the full protocol."""
     out = ["## Cost", ""]
-    rows, full_cpu = [], 0.0
+    rows, per_run = [], {}  # setting id -> full-protocol CPU s per run
     for s in settings:
         if not s.runs:
             continue
         wall = statistics.median(r.record["seconds"] for r in s.runs)
         cpu = statistics.median(r.record["cpu_seconds"] for r in s.runs)
-        gens = s.runs[0].record["settings"].get("generations")
         summary = s.runs[0].record.get("summary", {})
         gens = summary.get("generations") or s.runs[0].record["settings"].get("generations")
-        scale = _full_cpu(s, {**s.runs[0].record, "cpu_seconds": 1.0})
-        full_cpu += cpu * scale * study.seeds
+        scale = _full_cpu(s, {**s.runs[0].record, "cpu_seconds": 1.0}, _fixed_share(s.runs[0]))
+        per_run[s.setting_id] = cpu * scale
         machine = s.runs[0].record.get("machine", "")
         rows.append(
             f"| {figures.setting_label(s.values, list(study.grid))} | {wall / 60:.1f} | "
             f"{cpu / 60:.1f} | {gens} | {cpu * scale / 60:.1f} | {machine} |"
         )
+    full_cpu = study.seeds * sum(_imputed(s, settings, per_run) for s in settings)
     measured, total = len(rows), len(settings)
-    if measured and measured < total:
-        # Settings without a finished run yet are costed at the measured settings' mean.
-        full_cpu *= total / measured
     partial = (
-        f" ({measured} of {total} settings measured; the others are taken at the measured "
-        "settings' mean)"
+        f" ({measured} of {total} settings measured; each other one is taken at the mean "
+        "of the measured settings of its approach)"
         if measured < total
         else ""
     )
@@ -288,8 +285,10 @@ def _costs(study: Study, settings: list[SettingResults]) -> list[str]:
         "Measured per run (median over the setting's runs; one numba thread per run, on a "
         "machine shared with other work, so wall times are upper bounds; the CPU time is "
         "the run's own). The full-protocol column scales the CPU time by the generations "
-        "of the full protocol (standard NEAT's equal-budget generations included; the "
-        "repertoire is a few seconds of it).",
+        "of the full protocol (standard NEAT's equal-budget generations included); the "
+        "part of an EvoRBC run outside arbitrator evolution (its repertoire: seconds for a "
+        "4WS robot, hours for a PyBullet one) is fixed, estimated from the arbitrator "
+        "file's evolution time against the run's wall time.",
         "",
         "| setting | wall min/run | CPU min/run | generations | CPU min/run, full | machine |",
         "|---|---|---|---|---|---|",
@@ -303,26 +302,60 @@ def _costs(study: Study, settings: list[SettingResults]) -> list[str]:
         "| machines x cores | wall time |",
         "|---|---|",
     ]
-    longest = max((_full_cpu(s, r.record) for s in settings for r in s.runs), default=0.0)
+    longest = max(
+        (_full_cpu(s, r.record, _fixed_share(r)) for s in settings for r in s.runs),
+        default=0.0,
+    )
     for n, m in CLUSTERS:
         hours = max(full_cpu / (n * m), longest) / 3600
         out.append(f"| {n} x {m} | {hours:.1f} h |")
     return [*out, ""]
 
 
-def _full_cpu(setting: SettingResults, record: dict) -> float:
+def _full_cpu(setting: SettingResults, record: dict, fixed: float = 0.0) -> float:
     """A run's CPU seconds scaled to the full protocol's generations (the study file's).
 
     A standard-NEAT run at equal budget ran more generations than asked (the repertoire's
     evaluations as extra generations, ``summary.generations``); the extra is the same at
-    any length, so the full run has it too.
+    any length, so the full run has it too. ``fixed``: the share of the run that does not
+    grow with generations (an EvoRBC run's repertoire, :func:`_fixed_share`).
     """
     done = record["settings"].get("generations")
     full = setting.values.get("generations")
     if not (done and full):
         return record["cpu_seconds"]
     extra = (record.get("summary", {}).get("generations") or done) - done
-    return record["cpu_seconds"] * (full + extra) / (done + extra)
+    grows = (full + extra) / (done + extra)
+    return record["cpu_seconds"] * (fixed + (1.0 - fixed) * grows)
+
+
+def _fixed_share(run) -> float:
+    """The share of a run's time outside arbitrator evolution, in [0, 1].
+
+    From the arbitrator file's evolution seconds against the run's wall seconds: the
+    commands run one after the other, so the rest is the repertoire (EvoRBC) and the
+    commands' start-up; CPU is assumed to split the same way.
+    """
+    try:
+        evolution = float(run.arbitrator_data["evolution"]["seconds"])
+        total = float(run.record["seconds"])
+    except (OSError, KeyError, TypeError, ValueError):
+        return 0.0
+    return min(1.0, max(0.0, 1.0 - evolution / total)) if total > 0 else 0.0
+
+
+def _imputed(setting: SettingResults, settings: list[SettingResults], per_run: dict) -> float:
+    """Full-protocol CPU s per run of ``setting``: measured, else its approach's mean."""
+    if setting.setting_id in per_run:
+        return per_run[setting.setting_id]
+    approach = setting.values.get("approach", "evorbc")
+    same = [
+        per_run[s.setting_id]
+        for s in settings
+        if s.setting_id in per_run and s.values.get("approach", "evorbc") == approach
+    ]
+    pool = same or list(per_run.values())
+    return statistics.fmean(pool) if pool else 0.0
 
 
 def _full_generations(study: Study, settings: list[SettingResults]) -> str:
