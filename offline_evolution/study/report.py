@@ -211,9 +211,10 @@ def _markdown(study, settings: list[SettingResults], keys, claims, drawn, result
         f"with Holm-Bonferroni within each family of comparisons, significance at "
         f"{ALPHA}. Effect sizes: Vargha-Delaney A12 (the chance that a run of the first "
         "setting beats one of the second; 0.5 = no effect), epsilon-squared, Pearson's r. "
-        "A claim of *no difference* holds when no test finds one and no effect is large "
-        "(A12 within 0.29-0.71); with few runs that is weak evidence. A claim that a "
-        "setting is *best* holds only if it leads and is significantly above the runner-up.",
+        "A claim of *no difference* holds when no test finds one and no pairwise effect "
+        "is large (A12 strictly between 0.29 and 0.71); with few runs that is weak "
+        "evidence. A claim that a setting is *best* holds only if it leads and is "
+        "significantly above every other setting.",
         "",
     ]
     lines += _claims_table(claims)
