@@ -94,3 +94,22 @@ def test_validation_mazes_may_change_when_a_run_resumes(
     # two own mazes x (nominal + 1 draw) + 3 validation mazes x 1 start
     assert result.post_evaluation.episodes == 2 * 2 + 3
     assert result.post_evaluation.rule == "balanced"
+
+
+def test_nominal_then_balanced_keeps_the_candidates_that_reach_every_nominal_start():
+    # columns: 1 nominal row, 1 random row in the task's own maze, then 2 validation rows
+    fitness = [
+        [0.9, 1.3, 1.3, 1.3],  # misses the nominal start: best balanced (1.2), not eligible
+        [1.1, 1.0, 1.0, 1.0],  # reaches it: balanced 1.025
+        [1.1, 0.6, 1.2, 1.2],  # reaches it: balanced 1.0125
+    ]
+    reached = [[0, 1, 1, 1], [1, 1, 1, 1], [1, 0, 1, 1]]
+    task = _ScoredTask(fitness, np.array(reached, dtype=bool))
+    starts = np.zeros((4, 4))
+    args = (task, None, [0, 1, 2], starts)
+    assert post_evaluate(*args, "balanced", 1, validation=2).index == 0
+    post = post_evaluate(*args, "nominal_then_balanced", 1, validation=2)
+    assert post.index == 1 and post.reached_nominal and post.nominal_reachers == 2
+    # When no candidate reaches every nominal start it is the balanced rule.
+    task = _ScoredTask(fitness, np.zeros((3, 4), dtype=bool))
+    assert post_evaluate(task, None, [0, 1, 2], starts, "nominal_then_balanced", 1, 2).index == 0

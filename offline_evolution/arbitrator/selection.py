@@ -27,8 +27,10 @@ POST_EVALUATION_STREAM = 2**31 - 1
 #: every maze's nominal start (where a demo starts the robot), or by ``mean`` when none does;
 #: ``balanced``: the highest mean of two means, over the task's own mazes' episodes and over
 #: its generated validation mazes' episodes, so that neither suite outweighs the other by its
-#: number of episodes (equal to ``mean`` for a task without validation mazes).
-RULES = ("mean", "nominal_then_mean", "balanced")
+#: number of episodes (equal to ``mean`` for a task without validation mazes);
+#: ``nominal_then_balanced``: ``balanced`` among the candidates that reach the target from
+#: every nominal start of the task's own mazes, or ``balanced`` when none does.
+RULES = ("mean", "nominal_then_mean", "balanced", "nominal_then_balanced")
 
 
 class HallOfFame:
@@ -184,9 +186,10 @@ def post_evaluate(
     if nominal_rows is None:
         nominal_rows = len(task.mazes)
     nominal = reached_all[:, :nominal_rows].all(axis=1)
-    eligible = nominal if rule == "nominal_then_mean" and nominal.any() else np.ones_like(nominal)
+    nominal_first = rule in ("nominal_then_mean", "nominal_then_balanced")
+    eligible = nominal if nominal_first and nominal.any() else np.ones_like(nominal)
     score = fitness
-    if rule == "balanced" and 0 < validation < n:
+    if rule in ("balanced", "nominal_then_balanced") and 0 < validation < n:
         per_episode = result.fitness.reshape(len(networks), n)
         own, held = per_episode[:, : n - validation], per_episode[:, n - validation :]
         score = 0.5 * (own.mean(axis=1) + held.mean(axis=1))
