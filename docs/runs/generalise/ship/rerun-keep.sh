@@ -1,8 +1,8 @@
 #!/bin/sh
-# Rerun a finished ship candidate to GENERATIONS with its checkpoint kept at the end, so
+# Run (or rerun) a ship candidate to GENERATIONS with its checkpoint kept at the end, so
 # that other post-selection rules can be tried on the same run later (selection-only
-# settings may change on resume: docs/design.md section 13). The evolution is seeded and
-# repeats the original run exactly; only the written controller can differ.
+# settings may change on resume: docs/design.md section 13). The evolution is seeded: a
+# rerun repeats the original run exactly, and only the written controller can differ.
 #   usage: sh docs/runs/generalise/ship/rerun-keep.sh NAME TASK SEED GENERATIONS SETTINGS
 #   e.g.   sh docs/runs/generalise/ship/rerun-keep.sh 4ws-5-p8-p1-ntb docs/runs/generalise/ship/task-p8-p1.yaml 1 1000 docs/runs/generalise/ship/select-ntb.yaml
 # (Edit this file only by replacing it, never in place: a running sh reads it as it goes.)
