@@ -325,9 +325,16 @@ def _full_cpu(setting: SettingResults, record: dict, fixed: float = 0.0) -> floa
     full = setting.values.get("generations")
     if not (done and full):
         return record["cpu_seconds"]
-    extra = (record.get("summary", {}).get("generations") or done) - done
+    extra = _extra_generations(record)
     grows = (full + extra) / (done + extra)
     return record["cpu_seconds"] * (fixed + (1.0 - fixed) * grows)
+
+
+def _extra_generations(record: dict) -> int:
+    """Generations a run ran beyond those asked (standard NEAT at equal budget), else 0."""
+    asked = record["settings"].get("generations")
+    ran = record.get("summary", {}).get("generations")
+    return ran - asked if asked and ran else 0
 
 
 def _fixed_share(run) -> float:
@@ -362,16 +369,7 @@ def _imputed(setting: SettingResults, settings: list[SettingResults], per_run: d
 def _full_generations(study: Study, settings: list[SettingResults]) -> str:
     """`` (the full protocol: 1000, ...)`` for the protocol line of the report."""
     full = sorted({s.values.get("generations") for s in settings} - {None})
-    extra = sorted(
-        {
-            r.record["summary"]["generations"] - r.record["settings"]["generations"]
-            for s in settings
-            for r in s.runs
-            if r.record.get("summary", {}).get("generations")
-            and r.record["settings"].get("generations")
-        }
-        - {0}
-    )
+    extra = sorted({_extra_generations(r.record) for s in settings for r in s.runs} - {0})
     text = f" (the full protocol: {', '.join(map(str, full))})" if full else ""
     if extra:
         text += (

@@ -214,12 +214,15 @@ def _best(target: dict, samples) -> Comparison:
         return Comparison(
             _label(target), "best", sizes=(0,), note="no runs of this setting", outcome=INCONCLUSIVE
         )
+    # Each other group of the target's keys once (settings that share them are pooled).
+    groups = {
+        tuple((k, v[k]) for k in target) for v, s in samples if len(s) and not select(v, target)
+    }
     others = []
-    for v, s in samples:
-        if len(s) and not select(v, target):
-            key = {k: v[k] for k in target}
-            p, a12 = mann_whitney(own, _pooled(samples, key))
-            others.append((_mean(s), _label(key), p, a12))
+    for group in sorted(groups, key=str):
+        pooled = _pooled(samples, dict(group))
+        p, a12 = mann_whitney(own, pooled)
+        others.append((_mean(pooled), _label(dict(group)), p, a12))
     if not others:
         return Comparison(
             _label(target), "best", sizes=(len(own),), note="no other setting",
