@@ -20,7 +20,7 @@ from sim_bridge.robots.hexapod import HexapodRobot
 pytest.importorskip("ray")
 
 GENES_SEED = 5
-N_PRIMITIVES = 240
+N_PRIMITIVES = 600  # enough that a quiet 2-core machine is still busy after 3 s
 EVAL_TIME = 2.0  # s
 # Runs in its own process, connected to the cluster through EVORBC_CLUSTER, as the CLI is.
 PRIMITIVES = f"""
