@@ -182,3 +182,20 @@ def test_same_with_a_large_unproven_effect_is_inconclusive():
     comp = result.comparisons[0]
     assert comp.p > 0.05 and comp.effect == 1.0
     assert result.verdict == INCONCLUSIVE
+
+
+@pytest.mark.parametrize(
+    ("first", "second", "verdict"),
+    [
+        ([1.20, 1.21, 1.22], [1.30, 1.31, 1.32], INCONCLUSIVE),  # lower in every pair, p 0.1
+        ([1.30, 1.31, 1.32], [1.20, 1.21, 1.22], HOLDS),  # higher: never against the claim
+        ([1.20, 1.31, 1.22], [1.30, 1.21, 1.32], HOLDS),  # mixed: A12 0.33, not large
+    ],
+)
+def test_not_less_with_a_large_unproven_loss_is_inconclusive(first, second, verdict):
+    samples = [({"b": 0.01}, np.array(first)), ({"b": 0.02}, np.array(second))]
+    claim = {"claim": "smaller bins", "test": "mann-whitney", "adjacent": "b",
+             "expect": "not-less"}  # fmt: skip
+    (result,) = evaluate_claims([claim], samples)
+    assert result.comparisons[0].p > 0.05
+    assert result.verdict == verdict

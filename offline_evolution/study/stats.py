@@ -17,7 +17,9 @@ A claim's verdict, at ``ALPHA`` = 0.05 after adjustment:
   large (A12 at least 0.71 or at most 0.29: Vargha and Delaney's threshold of a large
   effect), *inconclusive* if a large pairwise effect is not significant, else *does not
   hold*; Kruskal-Wallis and correlation claims have no such guard;
-* ``not-less``: *holds* unless the first setting is significantly lower;
+* ``not-less``: *does not hold* if the first setting is significantly lower, is
+  *inconclusive* if it is lower by a large effect that is not significant (A12 at most
+  0.29), else *holds*;
 * ``best``: *holds* if the setting has the highest mean of all settings and is
   significantly above every other one (:func:`_best`), *does not hold* if another is
   significantly above it, else *inconclusive*.
@@ -302,13 +304,13 @@ def verdict(result: ClaimResult) -> str:
     if result.expect == "same":
         if significant:
             return FAILS
-        # 1e-9: an A12 of exactly 0.71 (possible with 10 or 30 runs) is large, as 0.29 is.
-        large = [
-            c for c in tested if c.effect_name == "A12" and abs(c.effect - 0.5) >= LARGE_A12 - 1e-9
-        ]
-        return INCONCLUSIVE if large else HOLDS
+        return INCONCLUSIVE if any(_large(c) for c in tested) else HOLDS
     if result.expect == "not-less":
-        return FAILS if any(c.effect < 0.5 for c in significant) else HOLDS
+        if any(c.effect < 0.5 for c in significant):
+            return FAILS
+        # A first setting that loses (almost) every pair is not shown "similar" by a test
+        # too weak to see it, as for ``same``.
+        return INCONCLUSIVE if any(_large(c) and c.effect < 0.5 for c in tested) else HOLDS
     if result.expect in ("greater", "less"):
         want_high = result.expect == "greater"
         if any((c.effect < 0.5) == want_high for c in significant):
@@ -319,6 +321,12 @@ def verdict(result: ClaimResult) -> str:
     if result.expect == "different":
         return HOLDS if significant else INCONCLUSIVE
     raise ValueError(f"unknown expectation {result.expect!r}")
+
+
+def _large(c: Comparison) -> bool:
+    """A pairwise comparison with a large effect (A12 at least 0.71 or at most 0.29)."""
+    # 1e-9: an A12 of exactly 0.71 (possible with 10 or 30 runs) is large, as 0.29 is.
+    return c.effect_name == "A12" and abs(c.effect - 0.5) >= LARGE_A12 - 1e-9
 
 
 def summary_row(values: dict[str, Any], keys: list[str]) -> str:
