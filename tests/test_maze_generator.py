@@ -7,6 +7,7 @@ clearance-aware path search the shipped mazes' tests use (``offline_evolution.ma
 from __future__ import annotations
 
 import functools
+import itertools
 import json
 
 import numpy as np
@@ -15,6 +16,7 @@ import pytest
 from offline_evolution.cli import main
 from offline_evolution.mazes.files import save_maze
 from offline_evolution.mazes.generator import (
+    EXTRA_KINDS,
     KINDS,
     TARGET_MODES,
     generate_maze,
@@ -129,6 +131,22 @@ def test_mazes_command_refuses_a_file_as_its_folder(tmp_path, capsys):
     assert "--out" in err and "expected a folder" in err and len(err.strip().splitlines()) == 1
 
 
+def test_mazes_command_draws_serpentines_on_request(tmp_path, capsys):
+    out = tmp_path / "winding"
+    args = ["mazes", "--count", "2", "--seed", "5", "--out", str(out), "--plot", "none"]
+    assert main([*args, "--serpentine", "0.5", "--json"]) == 0
+    made = json.loads(capsys.readouterr().out)["mazes"]
+    assert any("serpentine" in m["kinds"] for m in made)
+    spec = spec_for_robot("4ws-5")
+    assert load_maze(out / "gen5-000.yaml").to_dict() == (
+        generate_maze(spec, 5, 0, serpentine=0.5).maze.to_dict()
+    )
+    with pytest.raises(SystemExit) as info:
+        main([*args, "--serpentine", "1"])
+    assert info.value.code == 2
+    assert "--serpentine: expected a number in [0, 1)" in capsys.readouterr().err
+
+
 def test_any_registered_robot_gets_mazes_sized_from_its_registration(monkeypatch):
     import dataclasses
 
@@ -147,3 +165,30 @@ def test_any_registered_robot_gets_mazes_sized_from_its_registration(monkeypatch
         field = solve(maze, spec.cell, spec.margin, spec.snap)
         assert stranded_starts(maze, field, 0.08) == 0
         assert field.distance_from(*maze.start_pose[:2]) <= spec.path_limit
+
+
+def test_serpentines_wind_through_narrow_shafts_and_stay_out_of_the_standard_mix():
+    spec = spec_for_robot("4ws-5")
+    standard = [g for seed in SEEDS for g in mazes("4ws-5", seed)]
+    assert not any(set(EXTRA_KINDS) & set(g.kinds) for g in standard)
+    winding = [generate_maze(spec, 5, k, serpentine=0.5) for k in range(8)]
+    assert sum(g.kinds.count("serpentine") for g in winding) >= 8
+    for g in winding:
+        field = solve(g.maze)  # proven again, independently of the generator
+        assert stranded_starts(g.maze, field, ROBOT_RADIUS) == 0
+        assert field.distance_from(*g.maze.start_pose[:2]) <= 16.0
+
+    # Neighbouring full baffles from opposite walls as close as corridors' 0.36 m shafts
+    # (0.33-0.50 m apart), which the standard kinds never set that close.
+    def closest_shaft(g):
+        # Inner walls from the top or bottom wall (centre line at |y| = 0.689 m), by x.
+        xs = sorted(
+            (w[0], w[1] > 0)
+            for w in g.maze.walls
+            if w[0] == w[2] and abs(w[1]) > 0.68 and abs(w[0]) < 5.5
+        )
+        pairs = itertools.pairwise(xs)  # a gap's two pieces share an x: not a shaft
+        return min((b[0] - a[0] for a, b in pairs if a[1] != b[1] and b[0] > a[0]), default=9.0)
+
+    assert all(0.32 <= closest_shaft(g) <= 0.51 for g in winding if "serpentine" in g.kinds)
+    assert min(closest_shaft(g) for g in standard) > 0.51

@@ -224,6 +224,7 @@ def _net():
         ({"generated": 0}, "generated must be >= 1"),
         ({"perturb": "nosuch"}, "perturb: unknown perturbation set 'nosuch'"),
         ({"pools": 3}, "unknown setting 'pools' \\(did you mean 'pool'\\?\\)"),
+        ({"serpentine": 1.0}, "serpentine must be <= 0.9"),
     ],
 )
 def test_bad_training_settings_are_one_line_errors(tmp_path, training, message):
@@ -255,6 +256,20 @@ def test_settings_record_training_only_when_set():
     assert isinstance(s.training, TrainingSettings)
     again = MazeTaskSettings(**s.as_dict())  # as a checkpoint restores it
     assert again.training == s.training and again.as_dict() == s.as_dict()
+    # A setting added later is recorded only when set, so older checkpoints still resume.
+    assert "serpentine" not in s.as_dict()["training"]
+    winding = MazeTaskSettings.from_dict(task_dict(serpentine=0.3), "t")
+    assert winding.as_dict()["training"]["serpentine"] == 0.3
+    assert MazeTaskSettings(**winding.as_dict()).training.serpentine == 0.3
+
+
+def test_serpentine_training_draws_its_mazes_from_the_winding_mix():
+    task = training_task(serpentine=0.5)
+    task.generation_episodes(np.random.default_rng([3, 0]))
+    for maze in task.mazes[2:]:
+        index = int(maze.name.split("-")[1])
+        made = generate_maze(spec_for_robot("4ws-5"), 5, index, "train", 0.5)
+        assert np.array_equal(made.maze.walls, maze.walls)
 
 
 class _FakeSim:

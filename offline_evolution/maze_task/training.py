@@ -21,7 +21,10 @@ A maze task whose settings hold a ``training`` mapping trains on the generator's
   (the generator's clearance-aware path search) instead of the straight line, in every
   training maze and in the post-selection: ``1 - p_final / p_initial``. Eq. 5 as the
   paper writes it (``euclidean``) rewards closing in across a wall, which a maze's dead
-  ends and baffles turn into traps; the path length does not.
+  ends and baffles turn into traps; the path length does not;
+* ``serpentine: F`` makes a share F of the training mazes' obstacles serpentines (the
+  generator's narrow winding shafts, as in the paper's ``corridors``; the standard mix,
+  which the held-out set uses, has none), validation mazes included.
 
 Generated mazes are proven solvable by the generator; a task keeps the last
 :data:`CACHE` of them (and their compiled packs, 4WS), so a pool costs its generation once.
@@ -72,6 +75,13 @@ class TrainingSettings:
     distance: str = setting(
         "euclidean", doc="a missed episode's distance to the target: euclidean (eq. 5) or path"
     )
+    serpentine: float = setting(
+        0.0,
+        doc="share of the training mazes' obstacles that are serpentines (narrow winding "
+        "shafts as in corridors; 0: the standard mix, the held-out set's)",
+        minimum=0.0,
+        maximum=0.9,
+    )
 
     @classmethod
     def from_dict(cls, values, source: str) -> TrainingSettings:
@@ -118,6 +128,7 @@ class TrainingSettings:
             # Recorded only when set, so that files and checkpoints written before the
             # setting existed keep their exact settings (a resume compares them).
             **({"distance": self.distance} if self.distance != "euclidean" else {}),
+            **({"serpentine": self.serpentine} if self.serpentine else {}),
         }
 
 
@@ -191,7 +202,9 @@ class TrainingMazes:
         for index in map(int, indices):
             maze = self._cache.get(index)
             if maze is None:
-                made = generate_maze(self.spec, self.settings.maze_seed, index, PREFIX)
+                made = generate_maze(
+                    self.spec, self.settings.maze_seed, index, PREFIX, self.settings.serpentine
+                )
                 maze = made.maze
                 self._cache[index] = maze
                 if len(self._cache) > CACHE:

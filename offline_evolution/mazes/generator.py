@@ -17,7 +17,11 @@ by :mod:`sim_bridge.maze_plot`), made for one robot (docs/design.md section 21):
   ``diagonal`` (a leaning baffle), ``posts`` (one to three short free-standing walls),
   ``block`` (a closed box on a wall that forces a corridor around it), ``dead_end`` (a
   baffle with a shelf back towards the start: a pocket open towards the robot) and
-  ``chamber`` (a wide open slot).
+  ``chamber`` (a wide open slot). On request (``serpentine``, a share of the draws; the
+  standard mix, and so the held-out set, has none): ``serpentine``, two or three baffles
+  from alternating walls only 1.25-1.5 narrow gaps apart, the winding shafts of the paper's
+  ``corridors`` maze (0.36 m shafts, 0.455 m lanes), which the standard kinds never set
+  this close.
 * **Targets** anywhere reachable: ``wall`` (close to a wall of the last chamber, as in the
   paper's mazes), ``open`` (far from every wall), ``behind`` (in the lee of the last
   obstacle, behind a turn around its tip) or ``anywhere`` (any clear point of the maze's
@@ -57,6 +61,12 @@ from .paths import (
 #: Obstacle kinds, and how often each is drawn.
 KINDS = ("baffle", "gap", "diagonal", "posts", "block", "dead_end", "chamber")
 _KIND_WEIGHTS = (0.22, 0.18, 0.14, 0.14, 0.12, 0.1, 0.1)
+#: Kinds drawn only when asked for (``generate_maze(serpentine=...)``): outside the standard
+#: mix, so that the held-out set (docs/design.md section 21) stays what it was.
+EXTRA_KINDS = ("serpentine",)
+#: A serpentine's shaft width (m, between its baffles), in narrow gaps: 0.33-0.50 m for the
+#: 4WS robots, about the 0.36 m shafts of ``corridors``.
+_SHAFT = (1.25, 1.5)
 #: Where targets go, and how often.
 TARGET_MODES = ("wall", "open", "behind", "anywhere")
 _TARGET_WEIGHTS = (0.3, 0.25, 0.25, 0.2)
@@ -244,6 +254,15 @@ def _place(draft: _Draft, kind: str, a: float, b: float, rng: np.random.Generato
         draft.wall(x, _edge(s, side), x, y)
         draft.wall(x, y, x - shelf, y)
         draft.last_face = (x, side)
+    elif kind == "serpentine":
+        w = rng.uniform(_SHAFT[0] * s.narrow_gap[0], _SHAFT[1] * s.narrow_gap[1])
+        # Two baffles, or three when the slot holds them with its spacing kept around them.
+        n = 3 if (b - a) - s.spacing[0] >= 2 * w else 2
+        for i in range(n):
+            x = c + (i - 0.5 * (n - 1)) * w
+            draft.wall(x, _edge(s, side), x, _tip(s, side, opening))
+            draft.last_face = (x, side)
+            side = -side
     elif kind == "chamber":
         draft.last_face = None
     else:  # pragma: no cover - KINDS lists every kind
@@ -259,7 +278,19 @@ def _slot_length(kind: str, spec: MazeSpec, rng: np.random.Generator) -> float:
         return base * 1.5
     if kind == "chamber":
         return rng.uniform(1.0, 1.6) * spec.height
+    if kind == "serpentine":  # room for two or three shafts besides the spacing
+        return base + rng.uniform(1.0, 2.2) * _SHAFT[1] * spec.narrow_gap[1]
     return base
+
+
+def _kind_weights(serpentine: float) -> tuple[tuple[str, ...], np.ndarray]:
+    """The kinds drawn and their probabilities, with ``serpentine`` of the draws serpentines."""
+    if serpentine <= 0.0:
+        return KINDS, np.asarray(_KIND_WEIGHTS)
+    if not serpentine < 1.0:
+        raise ValueError(f"serpentine share must be below 1, got {serpentine}")
+    weights = [w * (1.0 - serpentine) for w in _KIND_WEIGHTS] + [serpentine]
+    return (*KINDS, "serpentine"), np.asarray(weights)
 
 
 def _maze_data(draft: _Draft, name: str, target: tuple[float, float], note: str) -> dict:
@@ -321,14 +352,17 @@ def _target(draft: _Draft, mode: str, walls_maze: Maze, goal_from: float, rng) -
     return _clear_point(walls_maze, rng, (0.0, hw), (near_wall[0], math.inf))
 
 
-def _draw(spec: MazeSpec, rng: np.random.Generator, name: str) -> tuple[dict, _Draft, str]:
+def _draw(
+    spec: MazeSpec, rng: np.random.Generator, name: str, serpentine: float = 0.0
+) -> tuple[dict, _Draft, str]:
     """One draft maze (not yet proven)."""
+    kinds, weights = _kind_weights(serpentine)
     hw = 0.5 * spec.width
     draft = _Draft(spec)
     x = -hw + spec.first_obstacle
     goal_room = max(0.6 * spec.height, 2.0 * (spec.margin + spec.target_radius))
     while True:
-        kind = str(rng.choice(KINDS, p=_KIND_WEIGHTS))
+        kind = str(rng.choice(kinds, p=weights))
         length = _slot_length(kind, spec, rng)
         if x + length > hw - goal_room:
             break
@@ -344,8 +378,13 @@ def _draw(spec: MazeSpec, rng: np.random.Generator, name: str) -> tuple[dict, _D
     return _maze_data(draft, name, target or (hw - 0.5 * goal_room, 0.0), note), draft, mode
 
 
-def generate_maze(spec: MazeSpec, seed: int, index: int, prefix: str = "gen") -> GeneratedMaze:
+def generate_maze(
+    spec: MazeSpec, seed: int, index: int, prefix: str = "gen", serpentine: float = 0.0
+) -> GeneratedMaze:
     """Maze ``index`` of ``seed`` for ``spec``, proven solvable (see the module docstring).
+
+    ``serpentine`` (in [0, 1)) is the share of obstacle draws that are serpentines; 0, the
+    default, is the standard mix (the same mazes as before the kind existed).
 
     Raises:
         RuntimeError: no draw in :data:`MAX_TRIES` passed the proof (a spec too tight).
@@ -353,7 +392,7 @@ def generate_maze(spec: MazeSpec, seed: int, index: int, prefix: str = "gen") ->
     rng = np.random.default_rng([seed, index])
     name = f"{prefix}{seed}-{index:03d}"
     for attempt in range(1, MAX_TRIES + 1):
-        data, draft, mode = _draw(spec, rng, name)
+        data, draft, mode = _draw(spec, rng, name, serpentine)
         before = [
             k for k, a in zip(draft.kinds, draft.starts, strict=True) if a < data["target"][0]
         ]
@@ -396,7 +435,9 @@ def _proof(maze: Maze, spec: MazeSpec) -> tuple[float, float, Field] | None:
     return longest, gap, field_
 
 
-def generate_mazes(robot: str, count: int, seed: int, prefix: str = "gen") -> list[GeneratedMaze]:
+def generate_mazes(
+    robot: str, count: int, seed: int, prefix: str = "gen", serpentine: float = 0.0
+) -> list[GeneratedMaze]:
     """``count`` proven mazes for ``robot``: mazes ``0 .. count-1`` of ``seed``."""
     spec = spec_for_robot(robot)
-    return [generate_maze(spec, seed, k, prefix) for k in range(count)]
+    return [generate_maze(spec, seed, k, prefix, serpentine) for k in range(count)]
