@@ -5,7 +5,9 @@
 # with ../run.sh's), then the same run continued to GENERATIONS (NAME-seedS.*), each
 # evaluated on the three suites of evaluate.sh. Re-running the same command resumes from the
 # checkpoint and skips what is done. SETTINGS, if given, is the run settings file
-# (--config; select.yaml: snapshots and the balanced post-selection).
+# (--config; select.yaml: snapshots and the balanced post-selection). The checkpoint is
+# kept at the end, so that other post-selection rules can be tried on the finished run
+# (selection-only settings may change on resume: docs/design.md section 13).
 #   usage: sh docs/runs/generalise/ship/run.sh NAME TASK [SEED] [GENERATIONS] [SETTINGS]
 #   e.g.   sh docs/runs/generalise/ship/run.sh 4ws-5-s6-p1 docs/runs/generalise/ship/task-s6-p1.yaml 1 1000 docs/runs/generalise/ship/select.yaml
 # (Edit this file only by replacing it, never in place: a running sh reads it as it goes.)
@@ -23,6 +25,6 @@ if [ ! -f $out-g300.arbitrator.json ]; then
 fi
 sh docs/runs/generalise/evaluate.sh $out-g300
 if [ ! -f $out.arbitrator.json ] || [ -f $out.checkpoint.json ]; then
-  evolve --generations $gens --out $out.arbitrator.json
+  evolve --generations $gens --keep-checkpoint --out $out.arbitrator.json
 fi
 sh docs/runs/generalise/evaluate.sh $out
