@@ -7,12 +7,14 @@ clearance-aware path search the shipped mazes' tests use (``offline_evolution.ma
 from __future__ import annotations
 
 import functools
+import hashlib
 import itertools
 import json
 
 import numpy as np
 import pytest
 
+from evorbc_ros.config import ConfigError
 from offline_evolution.cli import main
 from offline_evolution.mazes.files import save_maze
 from offline_evolution.mazes.generator import (
@@ -135,16 +137,40 @@ def test_mazes_command_draws_serpentines_on_request(tmp_path, capsys):
     out = tmp_path / "winding"
     args = ["mazes", "--count", "2", "--seed", "5", "--out", str(out), "--plot", "none"]
     assert main([*args, "--serpentine", "0.5", "--json"]) == 0
-    made = json.loads(capsys.readouterr().out)["mazes"]
-    assert any("serpentine" in m["kinds"] for m in made)
+    report = json.loads(capsys.readouterr().out)
+    assert report["serpentine"] == 0.5
+    assert any("serpentine" in m["kinds"] for m in report["mazes"])
     spec = spec_for_robot("4ws-5")
-    assert load_maze(out / "gen5-000.yaml").to_dict() == (
-        generate_maze(spec, 5, 0, serpentine=0.5).maze.to_dict()
+    # Named apart from the standard mix's mazes (never a held-out maze's name).
+    assert load_maze(out / "serp5-000.yaml").to_dict() == (
+        generate_maze(spec, 5, 0, "serp", serpentine=0.5).maze.to_dict()
     )
     with pytest.raises(SystemExit) as info:
         main([*args, "--serpentine", "1"])
     assert info.value.code == 2
-    assert "--serpentine: expected a number in [0, 1)" in capsys.readouterr().err
+    assert "--serpentine: expected a number in [0, 0.9]" in capsys.readouterr().err
+    for bad, message in [
+        (["--seed", "21021"], "--seed 21021 is the held-out set's"),
+        (["--robot", "hexapod"], "hexapod's mazes cannot hold serpentines"),
+    ]:
+        assert main([*args, "--serpentine", "0.2", *bad]) == 1
+        err = capsys.readouterr().err
+        assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_the_standard_mix_is_pinned():
+    """The held-out set is the standard mix's: its first ten 4ws-5 mazes, wall for wall."""
+    spec = spec_for_robot("4ws-5")
+    made = [generate_maze(spec, 21021, k).maze.to_dict() for k in range(10)]
+    digest = hashlib.sha256(json.dumps(made, sort_keys=True).encode()).hexdigest()
+    assert digest == "0fcab16ebfc4f7a251ebf8b6e236f803cdaf4158b335f8804e8b9853804799c7"
+
+
+@pytest.mark.parametrize("robot", ["hexapod", "a1"])
+def test_legged_mazes_refuse_serpentines(robot):
+    spec = spec_for_robot(robot)
+    with pytest.raises(ConfigError, match=f"{robot}'s mazes cannot hold serpentines"):
+        generate_maze(spec, 5, 0, serpentine=0.2)
 
 
 def test_any_registered_robot_gets_mazes_sized_from_its_registration(monkeypatch):
@@ -179,7 +205,8 @@ def test_serpentines_wind_through_narrow_shafts_and_stay_out_of_the_standard_mix
         assert field.distance_from(*g.maze.start_pose[:2]) <= 16.0
 
     # Neighbouring full baffles from opposite walls as close as corridors' 0.36 m shafts
-    # (0.33-0.50 m apart), which the standard kinds never set that close.
+    # (0.33-0.50 m apart), which the standard kinds rarely set that close (not in these
+    # seeds' mazes).
     def closest_shaft(g):
         # Inner walls from the top or bottom wall (centre line at |y| = 0.689 m), by x.
         xs = sorted(

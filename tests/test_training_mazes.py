@@ -16,7 +16,7 @@ from offline_evolution.arbitrator.selection import post_evaluation_starts
 from offline_evolution.checkpoint import Interrupted
 from offline_evolution.maze_task import kernel
 from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
-from offline_evolution.maze_task.training import TrainingSettings
+from offline_evolution.maze_task.training import TrainingMazes, TrainingSettings
 from offline_evolution.maze_task.world import pack_mazes
 from offline_evolution.mazes.generator import generate_maze, spec_for_robot
 
@@ -261,6 +261,15 @@ def test_settings_record_training_only_when_set():
     winding = MazeTaskSettings.from_dict(task_dict(serpentine=0.3), "t")
     assert winding.as_dict()["training"]["serpentine"] == 0.3
     assert MazeTaskSettings(**winding.as_dict()).training.serpentine == 0.3
+
+
+def test_serpentine_training_refuses_a_robot_whose_mazes_cannot_hold_them():
+    values = {"mazes": ["hexapod"], "episode_time": 30.0, "sensors": "sensors/hexapod.yaml"}
+    settings = MazeTaskSettings.from_dict(
+        {**values, "training": {"generated": 1, "serpentine": 0.2}}, "t.yaml"
+    )
+    with pytest.raises(ConfigError, match="hexapod's mazes cannot hold serpentines"):
+        TrainingMazes(settings.training, "hexapod")
 
 
 def test_serpentine_training_draws_its_mazes_from_the_winding_mix():

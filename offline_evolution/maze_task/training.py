@@ -166,10 +166,11 @@ class TrainingMazes:
     """
 
     def __init__(self, settings: TrainingSettings, robot: str):
-        from offline_evolution.mazes.generator import spec_for_robot
+        from offline_evolution.mazes.generator import check_serpentine, spec_for_robot
 
         self.settings = settings
         self.spec = spec_for_robot(robot)
+        check_serpentine(self.spec, settings.serpentine)
         self.perturbation: PerturbationSet = load_perturbations(settings.perturb)
         self._cache: OrderedDict[int, Maze] = OrderedDict()
         #: Path-distance grids by maze name (``distance: path`` only), the last GRID_CACHE.

@@ -19,9 +19,11 @@ by :mod:`sim_bridge.maze_plot`), made for one robot (docs/design.md section 21):
   baffle with a shelf back towards the start: a pocket open towards the robot) and
   ``chamber`` (a wide open slot). On request (``serpentine``, a share of the draws; the
   standard mix, and so the held-out set, has none): ``serpentine``, two or three baffles
-  from alternating walls only 1.25-1.5 narrow gaps apart, the winding shafts of the paper's
-  ``corridors`` maze (0.36 m shafts, 0.455 m lanes), which the standard kinds never set
-  this close.
+  from alternating walls 1.25 times the narrowest gap to 1.5 times the widest apart, the
+  winding shafts of the paper's ``corridors`` maze (0.36 m shafts, 0.455 m lanes); the
+  standard kinds set walls from opposite sides that close only rarely (about one maze in
+  300; none in the held-out set, whose closest pair is 0.63 m apart) and never as close as
+  ``corridors``. A 4WS-scale kind: the legged robots' mazes cannot hold it.
 * **Targets** anywhere reachable: ``wall`` (close to a wall of the last chamber, as in the
   paper's mazes), ``open`` (far from every wall), ``behind`` (in the lee of the last
   obstacle, behind a turn around its tip) or ``anywhere`` (any clear point of the maze's
@@ -64,8 +66,11 @@ _KIND_WEIGHTS = (0.22, 0.18, 0.14, 0.14, 0.12, 0.1, 0.1)
 #: Kinds drawn only when asked for (``generate_maze(serpentine=...)``): outside the standard
 #: mix, so that the held-out set (docs/design.md section 21) stays what it was.
 EXTRA_KINDS = ("serpentine",)
-#: A serpentine's shaft width (m, between its baffles), in narrow gaps: 0.33-0.50 m for the
-#: 4WS robots, about the 0.36 m shafts of ``corridors``.
+#: Largest serpentine share: above it few slots would hold anything else.
+MAX_SERPENTINE = 0.9
+#: A serpentine's shaft width (m, between its baffles): from this times the narrowest gap to
+#: this times the widest (0.33-0.50 m for the wheeled robots' mazes, about the 0.36 m shafts
+#: of ``corridors``).
 _SHAFT = (1.25, 1.5)
 #: Where targets go, and how often.
 TARGET_MODES = ("wall", "open", "behind", "anywhere")
@@ -283,12 +288,37 @@ def _slot_length(kind: str, spec: MazeSpec, rng: np.random.Generator) -> float:
     return base
 
 
+def _goal_room(spec: MazeSpec) -> float:
+    """Free length (m, along x) kept before the right wall for the target's chamber."""
+    return max(0.6 * spec.height, 2.0 * (spec.margin + spec.target_radius))
+
+
+def check_serpentine(spec: MazeSpec, share: float) -> None:
+    """Refuse a serpentine share out of range, or any for a robot whose mazes cannot hold them.
+
+    A serpentine takes up to ``spacing + 3.3`` narrow gaps of length; :data:`MIN_OBSTACLES`
+    of them must fit between the first obstacle and the goal room, or no draw with one
+    passes (the hexapod's and the A1's 8 m mazes with their 1 m gaps: serpentines are a
+    4WS-scale kind).
+
+    Raises:
+        ConfigError: naming the share, the range or the robot.
+    """
+    if not 0.0 <= share <= MAX_SERPENTINE:
+        raise ConfigError(f"serpentine share must be in [0, {MAX_SERPENTINE}], got {share}")
+    longest = spec.spacing[1] + 2.2 * _SHAFT[1] * spec.narrow_gap[1]
+    room = spec.width - spec.first_obstacle - _goal_room(spec)
+    if share > 0.0 and MIN_OBSTACLES * longest > room:
+        raise ConfigError(
+            f"serpentine: {spec.robot}'s mazes cannot hold serpentines ({MIN_OBSTACLES} of "
+            f"up to {longest:.1f} m in {room:.1f} m); use 0 for this robot"
+        )
+
+
 def _kind_weights(serpentine: float) -> tuple[tuple[str, ...], np.ndarray]:
     """The kinds drawn and their probabilities, with ``serpentine`` of the draws serpentines."""
-    if serpentine <= 0.0:
+    if serpentine == 0.0:
         return KINDS, np.asarray(_KIND_WEIGHTS)
-    if not serpentine < 1.0:
-        raise ValueError(f"serpentine share must be below 1, got {serpentine}")
     weights = [w * (1.0 - serpentine) for w in _KIND_WEIGHTS] + [serpentine]
     return (*KINDS, "serpentine"), np.asarray(weights)
 
@@ -360,7 +390,7 @@ def _draw(
     hw = 0.5 * spec.width
     draft = _Draft(spec)
     x = -hw + spec.first_obstacle
-    goal_room = max(0.6 * spec.height, 2.0 * (spec.margin + spec.target_radius))
+    goal_room = _goal_room(spec)
     while True:
         kind = str(rng.choice(kinds, p=weights))
         length = _slot_length(kind, spec, rng)
@@ -388,7 +418,10 @@ def generate_maze(
 
     Raises:
         RuntimeError: no draw in :data:`MAX_TRIES` passed the proof (a spec too tight).
+        ConfigError: a serpentine share out of range or for a robot that cannot hold one
+            (:func:`check_serpentine`).
     """
+    check_serpentine(spec, serpentine)
     rng = np.random.default_rng([seed, index])
     name = f"{prefix}{seed}-{index:03d}"
     for attempt in range(1, MAX_TRIES + 1):

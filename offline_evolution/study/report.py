@@ -213,9 +213,10 @@ def _markdown(study, settings: list[SettingResults], keys, claims, drawn, result
         "setting beats one of the second; 0.5 = no effect), epsilon-squared, Pearson's r. "
         "A claim of *no difference* holds when no test finds one and no pairwise effect "
         "is large (A12 strictly between 0.29 and 0.71); with few runs that is weak "
-        "evidence. A claim that one setting is *not worse* than another holds unless it "
-        "is significantly lower, and is inconclusive if it loses by a large effect that is "
-        "not significant (A12 at most 0.29). A claim that a setting is *best* holds only "
+        "evidence. A claim that one setting is *not worse* than another does not hold if "
+        "it is significantly lower, is inconclusive if it loses by a large effect that is "
+        "not significant (A12 at most 0.29), and holds otherwise. A claim that a setting "
+        "is *best* holds only "
         "if it leads and is "
         "significantly above every other setting.",
         "",

@@ -16,7 +16,7 @@ import json
 import os
 import sys
 
-from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.repertoire import Repertoire, RepertoireError
 from offline_evolution.arbitrator.evolve import Evolution, EvolutionSettings
 from offline_evolution.arbitrator.selection import post_evaluation_starts, validation_rows
 
@@ -25,7 +25,15 @@ def main(checkpoint: str, repertoire: str, out: str) -> None:
     """Write one row per candidate to ``out`` (JSON)."""
     with open(checkpoint) as f:
         settings = EvolutionSettings(**json.load(f)["settings"])
-    run = Evolution(settings, Repertoire.load(repertoire), 1)
+    try:
+        rep = Repertoire.load(repertoire)
+    except RepertoireError as e:
+        sys.exit(str(e))
+    if rep.fingerprint() != settings.repertoire_fingerprint:
+        sys.exit(f"{repertoire}: not the repertoire {checkpoint} was evolved with")
+    if not (settings.task.get("training") or {}).get("post_mazes"):
+        sys.exit(f"{checkpoint}: its task has no generated validation mazes to compare with")
+    run = Evolution(settings, rep, 1)
     try:
         run.restore(checkpoint)
         candidates = run.hall.candidates()
