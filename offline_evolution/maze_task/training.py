@@ -40,6 +40,12 @@ import numpy as np
 
 from evorbc_ros.config import ConfigError, build_settings, setting
 from offline_evolution.maze_task.perturbation import NONE, PerturbationSet, load_perturbations
+from offline_evolution.mazes.generator import (
+    MAX_SERPENTINE,
+    check_serpentine,
+    generate_maze,
+    spec_for_robot,
+)
 from offline_evolution.mazes.held_out import HELD_OUT_SEED, is_held_out
 from offline_evolution.mazes.paths import DistanceGrid
 from sim_bridge.maze import Maze
@@ -80,7 +86,7 @@ class TrainingSettings:
         doc="share of the training mazes' obstacles that are serpentines (narrow winding "
         "shafts as in corridors; 0: the standard mix, the held-out set's)",
         minimum=0.0,
-        maximum=0.9,
+        maximum=MAX_SERPENTINE,
     )
 
     @classmethod
@@ -166,8 +172,6 @@ class TrainingMazes:
     """
 
     def __init__(self, settings: TrainingSettings, robot: str):
-        from offline_evolution.mazes.generator import check_serpentine, spec_for_robot
-
         self.settings = settings
         self.spec = spec_for_robot(robot)
         check_serpentine(self.spec, settings.serpentine)
@@ -196,8 +200,6 @@ class TrainingMazes:
 
     def mazes(self, indices) -> list[Maze]:
         """Mazes ``indices`` of ``maze_seed``, each proven solvable (kept in a cache)."""
-        from offline_evolution.mazes.generator import generate_maze
-
         start = time.perf_counter()
         out = []
         for index in map(int, indices):

@@ -72,6 +72,8 @@ MAX_SERPENTINE = 0.9
 #: this times the widest (0.33-0.50 m for the wheeled robots' mazes, about the 0.36 m shafts
 #: of ``corridors``).
 _SHAFT = (1.25, 1.5)
+#: A serpentine slot's length beyond the spacing, in widest shafts (room for two or three).
+_SERPENTINE_LENGTH = (1.0, 2.2)
 #: Where targets go, and how often.
 TARGET_MODES = ("wall", "open", "behind", "anywhere")
 _TARGET_WEIGHTS = (0.3, 0.25, 0.25, 0.2)
@@ -284,7 +286,7 @@ def _slot_length(kind: str, spec: MazeSpec, rng: np.random.Generator) -> float:
     if kind == "chamber":
         return rng.uniform(1.0, 1.6) * spec.height
     if kind == "serpentine":  # room for two or three shafts besides the spacing
-        return base + rng.uniform(1.0, 2.2) * _SHAFT[1] * spec.narrow_gap[1]
+        return base + rng.uniform(*_SERPENTINE_LENGTH) * _SHAFT[1] * spec.narrow_gap[1]
     return base
 
 
@@ -306,7 +308,7 @@ def check_serpentine(spec: MazeSpec, share: float) -> None:
     """
     if not 0.0 <= share <= MAX_SERPENTINE:
         raise ConfigError(f"serpentine share must be in [0, {MAX_SERPENTINE}], got {share}")
-    longest = spec.spacing[1] + 2.2 * _SHAFT[1] * spec.narrow_gap[1]
+    longest = spec.spacing[1] + _SERPENTINE_LENGTH[1] * _SHAFT[1] * spec.narrow_gap[1]
     room = spec.width - spec.first_obstacle - _goal_room(spec)
     if share > 0.0 and MIN_OBSTACLES * longest > room:
         raise ConfigError(
@@ -320,7 +322,7 @@ def _kind_weights(serpentine: float) -> tuple[tuple[str, ...], np.ndarray]:
     if serpentine == 0.0:
         return KINDS, np.asarray(_KIND_WEIGHTS)
     weights = [w * (1.0 - serpentine) for w in _KIND_WEIGHTS] + [serpentine]
-    return (*KINDS, "serpentine"), np.asarray(weights)
+    return (*KINDS, *EXTRA_KINDS), np.asarray(weights)
 
 
 def _maze_data(draft: _Draft, name: str, target: tuple[float, float], note: str) -> dict:
@@ -413,8 +415,9 @@ def generate_maze(
 ) -> GeneratedMaze:
     """Maze ``index`` of ``seed`` for ``spec``, proven solvable (see the module docstring).
 
-    ``serpentine`` (in [0, 1)) is the share of obstacle draws that are serpentines; 0, the
-    default, is the standard mix (the same mazes as before the kind existed).
+    ``serpentine`` (in [0, :data:`MAX_SERPENTINE`]) is the share of obstacle draws that are
+    serpentines; 0, the default, is the standard mix (the same mazes as before the kind
+    existed).
 
     Raises:
         RuntimeError: no draw in :data:`MAX_TRIES` passed the proof (a spec too tight).
