@@ -113,3 +113,31 @@ def test_nominal_then_balanced_keeps_the_candidates_that_reach_every_nominal_sta
     # When no candidate reaches every nominal start it is the balanced rule.
     task = _ScoredTask(fitness, np.zeros((3, 4), dtype=bool))
     assert post_evaluate(task, None, [0, 1, 2], starts, "nominal_then_balanced", 1, 2).index == 0
+
+
+def test_reach_rule_weighs_the_two_suites_reach_rates_and_breaks_ties_by_fitness():
+    # columns: 2 rows in the task's own mazes, then 2 in validation mazes
+    fitness = [
+        [1.4, 1.4, 1.4, 1.4],  # reach own 0.5, validation 0.5: rate 0.5, best fitness
+        [1.0, 1.0, 1.0, 1.0],  # own 1.0, validation 0.5: rate 0.75
+        [1.1, 1.1, 1.1, 1.1],  # own 0.5, validation 1.0: rate 0.75, better fitness
+        [0.9, 0.9, 0.9, 0.9],  # own 0.0, validation 1.0: rate 0.5 (plain mean 0.5 too)
+    ]
+    reached = [[1, 0, 1, 0], [1, 1, 1, 0], [1, 0, 1, 1], [0, 0, 1, 1]]
+    task = _ScoredTask(fitness, np.array(reached, dtype=bool))
+    starts = np.zeros((4, 4))
+    args = (task, None, [0, 1, 2, 3], starts)
+    assert post_evaluate(*args, "mean", 1, validation=2).index == 0
+    post = post_evaluate(*args, "reach", 1, validation=2)
+    assert post.index == 2 and post.rule == "reach"
+    assert post.reached == pytest.approx(0.75)  # reported: the plain share of all episodes
+    # The suites weigh the same whatever their numbers of rows: with one own row and three
+    # validation rows, candidate 1 (own 1, validation 1/3: 0.67) beats candidates 2 and 3
+    # (own 0, validation 1: 0.5), which a plain share (0.75 against 0.5) would pick.
+    reached = [[1, 0, 0, 0], [1, 1, 0, 0], [0, 1, 1, 1], [0, 1, 1, 1]]
+    task = _ScoredTask(fitness, np.array(reached, dtype=bool))
+    assert post_evaluate(task, None, [0, 1, 2, 3], starts, "reach", 1, 3).index == 1
+    # Without validation rows it is the plain reach rate, ties by mean fitness.
+    reached = [[1, 1, 0, 0], [1, 1, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1]]
+    task = _ScoredTask(fitness, np.array(reached, dtype=bool))
+    assert post_evaluate(task, None, [0, 1, 2, 3], starts, "reach", 1, 0).index == 0

@@ -29,8 +29,11 @@ POST_EVALUATION_STREAM = 2**31 - 1
 #: its generated validation mazes' episodes, so that neither suite outweighs the other by its
 #: number of episodes (equal to ``mean`` for a task without validation mazes);
 #: ``nominal_then_balanced``: ``balanced`` among the candidates that reach the target from
-#: every nominal start of the task's own mazes, or ``balanced`` when none does.
-RULES = ("mean", "nominal_then_mean", "balanced", "nominal_then_balanced")
+#: every nominal start of the task's own mazes, or ``balanced`` when none does;
+#: ``reach``: the highest mean of two reach rates (shares of episodes that reach the
+#: target), over the task's own mazes and over its validation mazes, ties broken by
+#: ``balanced``: the shipped controllers' targets are reach rates (docs/design.md section 8).
+RULES = ("mean", "nominal_then_mean", "balanced", "nominal_then_balanced", "reach")
 
 
 class HallOfFame:
@@ -136,6 +139,17 @@ class PostEvaluation:
         }
 
 
+def _two_suite_mean(per_episode: np.ndarray, validation: int) -> np.ndarray:
+    """The two suites' means weighed equally, one per candidate row: shape (candidates,).
+
+    ``per_episode`` (candidates, episodes) ends with ``validation`` columns in validation
+    mazes; the rest are the task's own mazes. Neither suite counts by its number of episodes.
+    """
+    n = per_episode.shape[1]
+    own, held = per_episode[:, : n - validation], per_episode[:, n - validation :]
+    return 0.5 * (own.mean(axis=1) + held.mean(axis=1))
+
+
 def post_evaluation_starts(task: ArbitratorTask, seed: int, samples: int) -> np.ndarray:
     """The task's nominal starts, then ``samples`` seeded draws of its random starts.
 
@@ -189,11 +203,15 @@ def post_evaluate(
     nominal_first = rule in ("nominal_then_mean", "nominal_then_balanced")
     eligible = nominal if nominal_first and nominal.any() else np.ones_like(nominal)
     score = fitness
-    if rule in ("balanced", "nominal_then_balanced") and 0 < validation < n:
-        per_episode = result.fitness.reshape(len(networks), n)
-        own, held = per_episode[:, : n - validation], per_episode[:, n - validation :]
-        score = 0.5 * (own.mean(axis=1) + held.mean(axis=1))
-    k = int(np.argmax(np.where(eligible, score, -np.inf)))
+    if rule in ("balanced", "nominal_then_balanced", "reach") and 0 < validation < n:
+        score = _two_suite_mean(result.fitness.reshape(len(networks), n), validation)
+    if rule == "reach":
+        rate = _two_suite_mean(reached_all, validation) if 0 < validation < n else reached
+        # Highest reach rate first, then the better fitness score; ties to the earlier one.
+        order = np.lexsort((np.arange(len(networks)), -score, -rate))
+        k = int(order[0])
+    else:
+        k = int(np.argmax(np.where(eligible, score, -np.inf)))
     return PostEvaluation(
         k,
         float(fitness[k]),
