@@ -1,17 +1,23 @@
 #!/bin/sh
 # One legged screening run of docs/generalisation.md: evolve ROBOT's arbitrator on a task of
 # tasks/ with its shipped repertoire, then evaluate it from 20 random starts in its own maze
-# and on the 10 held-out mazes (seed 21021) x 20 starts (issue 21 item 5), unperturbed and under `realistic`, with
-# the episodes it was trained with. Re-running the same command resumes from the checkpoint.
-#   usage: sh docs/runs/generalise/run-legged.sh ROBOT NAME [SEED] [GENERATIONS] [NEAT.ini]
+# and on the 10 held-out mazes (seed 21021) x 20 starts (issue 21 item 5), unperturbed and
+# under `realistic`, with the episodes it was trained with. Re-running the same command
+# resumes from the checkpoint; the checkpoint is kept at the end, so that another
+# post-selection rule can be tried on the finished run (delete NAME-seedS.arbitrator.json
+# and run again with other SETTINGS: docs/design.md section 13).
+#   usage: sh docs/runs/generalise/run-legged.sh ROBOT NAME [SEED] [GENERATIONS] [NEAT.ini] [SETTINGS.yaml]
+#   e.g.   sh docs/runs/generalise/run-legged.sh hexapod hexapod-t90-s2 1 200 \
+#            docs/runs/generalise/tasks/hexapod-pop100.ini docs/runs/generalise/tasks/hexapod-reach.yaml
+# (Edit this file only by replacing it, never in place: a running sh reads it as it goes.)
 set -e
-robot=$1; name=$2; seed=${3:-1}; gens=${4:-200}; neat=${5:+--neat-config $5}
+robot=$1; name=$2; seed=${3:-1}; gens=${4:-200}; neat=${5:+--neat-config $5}; settings=${6:+--config $6}
 dir=docs/runs/generalise
 out=$dir/$name-seed$seed
-if [ ! -f $out.arbitrator.json ] || [ -f $out.checkpoint.json ]; then
+if [ ! -f $out.arbitrator.json ]; then
   .venv/bin/evorbc-evolve arbitrator --repertoire evorbc_ros/data/$robot.repertoire.json \
-    --task $dir/tasks/$name.yaml --seed $seed --generations $gens --quiet $neat \
-    --out $out.arbitrator.json --checkpoint $out.checkpoint.json
+    --task $dir/tasks/$name.yaml --seed $seed --generations $gens --quiet $neat $settings \
+    --keep-checkpoint --out $out.arbitrator.json --checkpoint $out.checkpoint.json
 fi
 for suite in own held ownr heldr; do
   [ -f $out.$suite.json ] && continue
