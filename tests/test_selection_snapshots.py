@@ -141,3 +141,23 @@ def test_reach_rule_weighs_the_two_suites_reach_rates_and_breaks_ties_by_fitness
     reached = [[1, 1, 0, 0], [1, 1, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1]]
     task = _ScoredTask(fitness, np.array(reached, dtype=bool))
     assert post_evaluate(task, None, [0, 1, 2, 3], starts, "reach", 1, 0).index == 0
+
+
+def test_nominal_then_reach_keeps_the_candidates_that_reach_every_nominal_start():
+    # columns: 1 nominal row, 2 random rows in the task's own maze (no validation mazes)
+    fitness = [[1.0, 1.0, 1.0], [1.2, 1.2, 1.2], [0.9, 0.9, 0.9]]
+    reached = [[0, 1, 1], [1, 1, 0], [1, 0, 1]]  # reach 2/3 each; 0 misses the nominal start
+    task = _ScoredTask(fitness, np.array(reached, dtype=bool))
+    starts = np.zeros((3, 4))
+    args = (task, None, [0, 1, 2], starts)
+    assert post_evaluate(*args, "reach", 1).index == 1  # all 2/3: the best fitness
+    reached = [[0, 1, 1], [1, 0, 0], [1, 0, 1]]
+    task = _ScoredTask(fitness, np.array(reached, dtype=bool))
+    args = (task, None, [0, 1, 2], starts)
+    assert post_evaluate(*args, "reach", 1).index == 0  # 2/3, though it misses the nominal
+    post = post_evaluate(*args, "nominal_then_reach", 1)
+    assert post.index == 2 and post.reached_nominal and post.nominal_reachers == 2
+    # When no candidate reaches the nominal start it is the reach rule.
+    reached = [[0, 1, 1], [0, 1, 0], [0, 0, 1]]
+    task = _ScoredTask(fitness, np.array(reached, dtype=bool))
+    assert post_evaluate(task, None, [0, 1, 2], starts, "nominal_then_reach", 1).index == 0

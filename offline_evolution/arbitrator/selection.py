@@ -32,8 +32,17 @@ POST_EVALUATION_STREAM = 2**31 - 1
 #: every nominal start of the task's own mazes, or ``balanced`` when none does;
 #: ``reach``: the highest mean of two reach rates (shares of episodes that reach the
 #: target), over the task's own mazes and over its validation mazes, ties broken by
-#: ``balanced``: the shipped controllers' targets are reach rates (docs/design.md section 8).
-RULES = ("mean", "nominal_then_mean", "balanced", "nominal_then_balanced", "reach")
+#: ``balanced``: the shipped controllers' targets are reach rates (docs/design.md section 8);
+#: ``nominal_then_reach``: ``reach`` among the candidates that reach the target from every
+#: nominal start, or ``reach`` when none does.
+RULES = (
+    "mean",
+    "nominal_then_mean",
+    "balanced",
+    "nominal_then_balanced",
+    "reach",
+    "nominal_then_reach",
+)
 
 
 class HallOfFame:
@@ -200,15 +209,16 @@ def post_evaluate(
     if nominal_rows is None:
         nominal_rows = len(task.mazes)
     nominal = reached_all[:, :nominal_rows].all(axis=1)
-    nominal_first = rule in ("nominal_then_mean", "nominal_then_balanced")
-    eligible = nominal if nominal_first and nominal.any() else np.ones_like(nominal)
+    base = rule.removeprefix("nominal_then_")
+    eligible = nominal if base != rule and nominal.any() else np.ones_like(nominal)
     score = fitness
-    if rule in ("balanced", "nominal_then_balanced", "reach") and 0 < validation < n:
+    if base in ("balanced", "reach") and 0 < validation < n:
         score = _two_suite_mean(result.fitness.reshape(len(networks), n), validation)
-    if rule == "reach":
+    if base == "reach":
         rate = _two_suite_mean(reached_all, validation) if 0 < validation < n else reached
-        # Highest reach rate first, then the better fitness score; ties to the earlier one.
-        order = np.lexsort((np.arange(len(networks)), -score, -rate))
+        # Eligible first, then the highest reach rate, then the better fitness score; ties
+        # go to the earlier candidate.
+        order = np.lexsort((np.arange(len(networks)), -score, -rate, ~eligible))
         k = int(order[0])
     else:
         k = int(np.argmax(np.where(eligible, score, -np.inf)))
