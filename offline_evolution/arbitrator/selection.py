@@ -32,7 +32,8 @@ POST_EVALUATION_STREAM = 2**31 - 1
 #: every nominal start of the task's own mazes, or ``balanced`` when none does;
 #: ``reach``: the highest mean of two reach rates (shares of episodes that reach the
 #: target), over the task's own mazes and over its validation mazes, ties broken by
-#: ``balanced``: the shipped controllers' targets are reach rates (docs/design.md section 8);
+#: ``balanced`` (without validation mazes: the share of all episodes, ties by ``mean``); the
+#: shipped generalising controllers' targets are reach rates (docs/design.md section 8);
 #: ``nominal_then_reach``: ``reach`` among the candidates that reach the target from every
 #: nominal start, or ``reach`` when none does.
 RULES = (
