@@ -14,7 +14,7 @@ from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.cli import main
 from offline_evolution.maze_task.base import MazeTaskSettings
-from offline_evolution.maze_task.evaluation import evaluate_suite, stalled
+from offline_evolution.maze_task.evaluation import evaluate_suite, reach_interval, stalled
 from offline_evolution.maze_task.perturbation import (
     NONE,
     QUANTITIES,
@@ -65,6 +65,10 @@ def test_shipped_4ws_controller_reaches_the_target_from_most_random_starts(tmp_p
     assert overall["reached"] == sum(e["reached"] for e in report["episodes"])
     assert overall["stalls"] >= 1  # it does stall in some (gaps: at a wall's end)
     assert "all" in table and "reach %" in table and "gaps" in table
+    assert "95 % interval" in table
+    low, high = overall["reach_interval"]
+    assert low < overall["reach_rate"] < high  # reached neither none nor all 100
+    assert (low, high) == reach_interval(overall["reached"], overall["episodes"])
     assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
@@ -177,3 +181,18 @@ def test_an_empty_maze_folder_and_one_file_for_two_outputs_are_refused(tmp_path,
     both = str(tmp_path / "r.png")
     assert main(["evaluate", "--plot", both, "--out", both]) == 1
     assert "--plot and --out name the same file" in capsys.readouterr().err
+
+
+def test_reach_interval_is_wilsons():
+    # 15 of 20 (the hexapod's own-maze figure): Wilson's 95 % interval is 0.531-0.888.
+    low, high = reach_interval(15, 20)
+    assert low == pytest.approx(0.5313, abs=1e-4) and high == pytest.approx(0.8881, abs=1e-4)
+    # It stays inside [0, 1] and is not empty at the ends, where the normal one collapses.
+    low, high = reach_interval(0, 20)
+    assert low == 0.0 and 0.15 < high < 0.17
+    low, high = reach_interval(20, 20)
+    assert 0.83 < low < 0.85 and high == 1.0
+    # More episodes, a narrower interval around the same rate.
+    wide, narrow = reach_interval(15, 20), reach_interval(750, 1000)
+    assert narrow[0] > wide[0] and narrow[1] < wide[1]
+    assert reach_interval(0, 0) == (0.0, 1.0)

@@ -229,16 +229,18 @@ def _generated_files(robot: str, n: int, seed: int, folder: Path) -> list[str]:
 
 def _print_table(rows: list[dict], overall: dict) -> None:
     print(
-        f"{'maze':<14} {'episodes':>8} {'reached':>7} {'reach %':>7} {'mean fitness':>12} "
-        f"{'stalls':>6} {'collisions':>10} {'falls':>5}"
+        f"{'maze':<14} {'episodes':>8} {'reached':>7} {'reach %':>7} {'95 % interval':>13} "
+        f"{'mean fitness':>12} {'stalls':>6} {'collisions':>10} {'falls':>5}"
     )
     for row in [*rows, overall]:
         if row is overall:
-            print("-" * 75)
+            print("-" * 89)
+        low, high = (100 * v for v in row["reach_interval"])
         print(
             f"{row['maze']:<14} {row['episodes']:>8} {row['reached']:>7} "
-            f"{100 * row['reach_rate']:>7.1f} {row['mean_fitness']:>12.3f} {row['stalls']:>6} "
-            f"{row['collisions']:>10} {row['falls']:>5}"
+            f"{100 * row['reach_rate']:>7.1f} {f'{low:.0f}-{high:.0f}':>13} "
+            f"{row['mean_fitness']:>12.3f} {row['stalls']:>6} {row['collisions']:>10} "
+            f"{row['falls']:>5}"
         )
 
 

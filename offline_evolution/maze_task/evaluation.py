@@ -86,8 +86,29 @@ class SuiteResult:
         return summarise(self.episodes, "all")
 
 
+#: Two-sided 95 % normal quantile, for :func:`reach_interval`.
+Z95 = 1.959963984540054
+
+
+def reach_interval(reached: int, n: int, z: float = Z95) -> tuple[float, float]:
+    """Wilson score interval (95 % by default) of a reach rate of ``reached`` in ``n``.
+
+    A rate from 20 starts is only known to about +-19 points (15 of 20: 0.53-0.89), so the
+    report gives the interval with every rate (docs/generalisation.md, "The hexapod"). Wilson's
+    interval, unlike the normal one, stays inside [0, 1] and is not empty at 0 or n.
+    Returns (low, high) shares; (0, 1) for no episodes.
+    """
+    if n <= 0:
+        return 0.0, 1.0
+    p = reached / n
+    denominator = 1.0 + z * z / n
+    centre = (p + z * z / (2 * n)) / denominator
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denominator
+    return float(max(0.0, centre - half)), float(min(1.0, centre + half))
+
+
 def summarise(episodes: list[SuiteEpisode], name: str) -> dict:
-    """Episodes, reached (count and rate), mean fitness, stalls, collisions and falls."""
+    """Episodes, reached (count, rate, 95 % interval), mean fitness, stalls, collisions, falls."""
     n = len(episodes)
     reached = sum(e.reached for e in episodes)
     return {
@@ -95,6 +116,7 @@ def summarise(episodes: list[SuiteEpisode], name: str) -> dict:
         "episodes": n,
         "reached": reached,
         "reach_rate": reached / n if n else 0.0,
+        "reach_interval": list(reach_interval(reached, n)),
         "mean_fitness": float(np.mean([e.fitness for e in episodes])) if n else 0.0,
         "stalls": sum(e.stalled for e in episodes),
         "collisions": sum(e.collided for e in episodes),
