@@ -86,12 +86,8 @@ class SuiteResult:
         return summarise(self.episodes, "all")
 
 
-#: Two-sided 95 % normal quantile, for :func:`reach_interval`.
-Z95 = 1.959963984540054
-
-
-def reach_interval(reached: int, n: int, z: float = Z95) -> tuple[float, float]:
-    """Wilson score interval (95 % by default) of a reach rate of ``reached`` in ``n``.
+def reach_interval(reached: int, n: int) -> tuple[float, float]:
+    """95 % Wilson score interval of a reach rate of ``reached`` in ``n`` (scipy's).
 
     A rate from 20 starts is only known to about +-19 points (15 of 20: 0.53-0.89), so the
     report gives the interval with every rate (docs/generalisation.md, "The hexapod"). Wilson's
@@ -100,11 +96,10 @@ def reach_interval(reached: int, n: int, z: float = Z95) -> tuple[float, float]:
     """
     if n <= 0:
         return 0.0, 1.0
-    p = reached / n
-    denominator = 1.0 + z * z / n
-    centre = (p + z * z / (2 * n)) / denominator
-    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denominator
-    return float(max(0.0, centre - half)), float(min(1.0, centre + half))
+    from scipy.stats import binomtest  # offline only; the evolution extra installs it
+
+    ci = binomtest(reached, n).proportion_ci(confidence_level=0.95, method="wilson")
+    return float(ci.low), float(ci.high)
 
 
 def summarise(episodes: list[SuiteEpisode], name: str) -> dict:
