@@ -22,6 +22,7 @@ from offline_evolution.maze_task.perturbation import (
     load_perturbations,
 )
 from offline_evolution.maze_task.task import make_task
+from sim_bridge.maze import load_named_maze
 
 PAPER = ("obstacle", "zigzag", "baffles", "corridors", "gaps")
 #: Every quantity at its identity value, given explicitly: a set that perturbs nothing.
@@ -70,6 +71,12 @@ def test_shipped_4ws_controller_reaches_the_target_from_most_random_starts(tmp_p
     assert low < overall["reach_rate"] < high  # reached neither none nor all 100
     assert (low, high) == reach_interval(overall["reached"], overall["episodes"])
     assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # Each episode says where it ended: inside the target circle if and only if it reached.
+    for e in report["episodes"]:
+        maze = load_named_maze(e["maze"])
+        miss = np.hypot(e["end"][0] - maze.target[0], e["end"][1] - maze.target[1])
+        assert miss == pytest.approx(e["final_distance"], abs=1e-5)
+        assert (miss <= maze.target_radius + 1e-5) == e["reached"]
 
 
 def test_a_perturbation_changes_outcomes_and_the_identity_set_changes_nothing():

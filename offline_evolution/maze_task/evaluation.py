@@ -45,6 +45,7 @@ class SuiteEpisode:
     fitness: float
     time: float  # s until the target, or the episode's end
     final_distance: float  # m, straight line to the target
+    end: tuple[float, float, float]  # the last pose: x m, y m, heading rad (maze frame)
     stalled: bool
     collided: bool
     contact_share: float  # share of the episode's poses touching a wall
@@ -59,6 +60,7 @@ class SuiteEpisode:
             "fitness": self.fitness,
             "time": round(self.time, 3),
             "final_distance": self.final_distance,
+            "end": [round(v, 6) for v in self.end],
             "stalled": self.stalled,
             "collided": self.collided,
             "contact_share": round(self.contact_share, 4),
@@ -205,6 +207,7 @@ def evaluate_suite(
                 fitness=float(result.fitness[e]),
                 time=n * task.dt,
                 final_distance=float(result.final_distance[e]),
+                end=tuple(float(v) for v in pose[-1]),
                 stalled=stalled(to_go, window, step),
                 collided=bool(touching.any()),
                 contact_share=float(touching.mean()),
