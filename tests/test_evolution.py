@@ -4,9 +4,11 @@ import json
 
 import numpy as np
 import pytest
+import yaml
 from conftest import SMALL_TASK
 
 from evorbc_ros.arbitrator import Arbitrator, ArbitratorFile
+from evorbc_ros.config import config_dir
 from offline_evolution.arbitrator.evolve import (
     EvolutionSettings,
     arbitrator_file,
@@ -168,36 +170,64 @@ def test_post_evaluation_settings_may_change_on_resume(tmp_path, small_neat_file
     assert result.post_evaluation.episodes == 2 * (1 + 3)  # two mazes
 
 
+def resumes_moved_but_not_edited(tmp_path, s, repertoire, moved, edit, refused):
+    """Run ``s`` straight; interrupt it and resume with ``moved()`` (the settings with an
+    input file at another path, same contents): the same result; interrupt again, ``edit()``
+    the moved file: resuming with ``moved()`` is refused with a message matching ``refused``."""
+    straight = evolve(s, repertoire)
+    ckpt = tmp_path / "c.json"
+    with pytest.raises(Interrupted):
+        evolve(s, repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    same(straight, evolve(moved(), repertoire, checkpoint=ckpt))
+    with pytest.raises(Interrupted):
+        evolve(s, repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    edit()
+    with pytest.raises(CheckpointError, match=refused):
+        evolve(moved(), repertoire, checkpoint=ckpt)
+
+
 def test_a_run_resumes_with_its_neat_file_elsewhere_but_not_edited(
     tmp_path, small_neat_file, small_repertoire
 ):
     # A long run carried to another checkout or machine finds its NEAT settings at another
     # path; only their contents decide whether the population may continue.
     s = settings(small_neat_file, generations=4, repertoire=small_repertoire)
-    straight = evolve(s, small_repertoire)
-    ckpt = tmp_path / "c.json"
-    with pytest.raises(Interrupted):
-        evolve(s, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
     moved = tmp_path / "elsewhere" / "neat.ini"
     moved.parent.mkdir()
     moved.write_text(small_neat_file.read_text())
-    same(
-        straight,
-        evolve(
-            settings(moved, generations=4, repertoire=small_repertoire),
-            small_repertoire,
-            checkpoint=ckpt,
-        ),
+    resumes_moved_but_not_edited(
+        tmp_path,
+        s,
+        small_repertoire,
+        lambda: settings(moved, generations=4, repertoire=small_repertoire),
+        lambda: moved.write_text(small_neat_file.read_text() + "\n# edited\n"),
+        "neat_sha256 is",
     )
-    with pytest.raises(Interrupted):
-        evolve(s, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
-    moved.write_text(small_neat_file.read_text() + "\n# edited\n")
-    with pytest.raises(CheckpointError, match="neat_sha256 is"):
-        evolve(
-            settings(moved, generations=4, repertoire=small_repertoire),
-            small_repertoire,
-            checkpoint=ckpt,
-        )
+
+
+def test_a_run_resumes_with_its_sensor_file_moved_but_not_with_another_layout(
+    tmp_path, small_neat_file, small_repertoire
+):
+    # A sensor layout moved into config/sensors to ship a controller (docs/design.md
+    # section 13) is the same layout: the run resumes; a different layout is another run.
+    s = settings(small_neat_file, generations=4, repertoire=small_repertoire)
+    moved = tmp_path / "layout.yaml"
+    moved.write_text((config_dir() / SMALL_TASK["sensors"]).read_text())
+
+    def longer_range():
+        layout = yaml.safe_load(moved.read_text())
+        layout["rangefinders"]["range"] *= 2
+        moved.write_text(yaml.safe_dump(layout))
+
+    task = {**SMALL_TASK, "sensors": str(moved)}
+    resumes_moved_but_not_edited(
+        tmp_path,
+        s,
+        small_repertoire,
+        lambda: EvolutionSettings(**{**s.as_dict(), "task": task}),
+        longer_range,
+        r"task\.sensors is 'layout",
+    )
 
 
 class _ScoredTask:

@@ -32,10 +32,11 @@ import numpy as np
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
-from evorbc_ros.config import ConfigError
+from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular
 from evorbc_ros.network import ConnectionSpec, NetworkSpec, NodeSpec
 from evorbc_ros.repertoire import Repertoire, RepertoireError
+from evorbc_ros.sensors import SensorLayout
 from offline_evolution.arbitrator.neat_config import load_neat_config
 from offline_evolution.arbitrator.neat_state import (
     genome_from_dict,
@@ -178,6 +179,24 @@ def _without_selection(settings: dict) -> dict:
         return settings
     kept = {k: v for k, v in training.items() if k not in TASK_SELECTION_ONLY}
     return {**settings, "task": {**task, "training": kept}}
+
+
+def _sensors_by_content(settings: dict) -> dict:
+    """``settings`` with the task's sensor file replaced by its layout's fingerprint (a copy).
+
+    A sensor file's location, like the NEAT file's, never changes what a run does: a run
+    whose layout file moved (into ``config/sensors`` to ship it, say) resumes from its
+    checkpoint if the layout it holds is the same. A file that does not load keeps its path,
+    so the comparison then names the path.
+    """
+    task = settings.get("task")
+    if not isinstance(task, dict) or not isinstance(task.get("sensors"), str):
+        return settings
+    try:
+        layout = SensorLayout.load(config_dir() / task["sensors"])
+    except (ConfigError, OSError):
+        return settings
+    return {**settings, "task": {**task, "sensors": f"layout {layout.fingerprint()}"}}
 
 
 def file_sha256(path: str | os.PathLike, what: str = "NEAT settings") -> str:
@@ -406,7 +425,9 @@ class Evolution:
         # changes its contents, so both may change between sessions.
         ignored = SELECTION_ONLY + LOCATION_ONLY + LENGTH_ONLY
         saved, now = (
-            _without_selection({k: v for k, v in d.items() if k not in ignored})
+            _sensors_by_content(
+                _without_selection({k: v for k, v in d.items() if k not in ignored})
+            )
             for d in (data["settings"], self.settings.as_dict())
         )
         mismatch = settings_mismatch(saved, now)
