@@ -14,14 +14,14 @@ import json
 import math
 import sys
 
+from offline_evolution.quality import wrap_angle
 from sim_bridge.maze import load_named_maze
 
 
 def bearing_deg(end: list[float], target: tuple[float, float]) -> float:
-    """The target's bearing from a pose ``(x, y, heading rad)``, in [-180, 180) deg."""
+    """The target's bearing from a pose ``(x, y, heading rad)``, in (-180, 180] deg."""
     x, y, heading = end
-    b = math.degrees(math.atan2(target[1] - y, target[0] - x) - heading)
-    return (b + 180.0) % 360.0 - 180.0
+    return math.degrees(float(wrap_angle(math.atan2(target[1] - y, target[0] - x) - heading)))
 
 
 def main() -> None:
