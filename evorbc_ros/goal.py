@@ -1,9 +1,10 @@
-"""Goal-direction inputs from the robot's pose and the goal (pure code of the radar node).
+"""Inputs from the robot's pose and the goal (pure code of the radar node).
 
 Poses come from odometry (``nav_msgs/Odometry``: position and orientation quaternion in a
 fixed frame) and the goal as a point in the same frame. The bearing of the goal in the body
 frame gives the goal-sector readings (4WS) or the goal-bearing reading (hexapod), with the
-formulas of :mod:`evorbc_ros.sensors`.
+formulas of :mod:`evorbc_ros.sensors`; a layout with a motion input adds the distance moved
+over its window (:mod:`evorbc_ros.motion`), for which the pose's stamp counts.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import math
 import numpy as np
 
 from evorbc_ros.laser import InputError
+from evorbc_ros.motion import MotionWindow
 from evorbc_ros.sensors import SensorLayout, goal_bearing_reading, goal_sector_readings
 
 
@@ -32,12 +34,21 @@ def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
 
 
 class GoalInputs:
-    """Goal-sector and goal-bearing readings of a layout."""
+    """Every input of a layout after the rangefinders: goal sectors, bearing and motion.
+
+    The motion input keeps the poses of its window; :meth:`reset` forgets them.
+    """
 
     def __init__(self, layout: SensorLayout):
-        if layout.goal_sectors is None and not layout.goal_bearing:
-            raise ValueError("the sensor layout has no goal inputs")
+        if layout.goal_sectors is None and not layout.goal_bearing and layout.motion is None:
+            raise ValueError("the sensor layout has no goal or motion inputs")
         self.layout = layout
+        self.motion = MotionWindow(layout.motion) if layout.motion else None
+
+    def reset(self) -> None:
+        """Forget the motion input's poses (a new episode); nothing else has state."""
+        if self.motion is not None:
+            self.motion.reset()
 
     @property
     def names(self) -> list[str]:
@@ -45,11 +56,15 @@ class GoalInputs:
         n_range = len(self.layout.rangefinders.angles) if self.layout.rangefinders else 0
         return self.layout.input_names()[n_range:]
 
-    def readings(self, x: float, y: float, yaw: float, gx: float, gy: float) -> np.ndarray:
+    def readings(
+        self, x: float, y: float, yaw: float, gx: float, gy: float, stamp_ns: int = 0
+    ) -> np.ndarray:
         """Readings for a robot at ``(x, y, yaw)`` and a goal at ``(gx, gy)`` (one frame).
 
+        ``stamp_ns``: the pose's time (ns), read only by a motion input.
+
         Raises:
-            InputError: a non-finite pose or goal.
+            InputError: a non-finite pose or goal (the motion window keeps no such pose).
         """
         for name, v in (("x", x), ("y", y), ("yaw", yaw), ("goal x", gx), ("goal y", gy)):
             if not math.isfinite(v):
@@ -60,4 +75,6 @@ class GoalInputs:
             out.extend(goal_sector_readings(bearing, self.layout.goal_sectors))
         if self.layout.goal_bearing:
             out.append(goal_bearing_reading(bearing))
+        if self.motion is not None:
+            out.append(self.motion.reading(stamp_ns, x, y))
         return np.array(out, dtype=np.float64)

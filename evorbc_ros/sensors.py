@@ -11,7 +11,12 @@ sector ``[centre - width/2, centre + width/2)``, else 0.
 
 Goal bearing (hexapod): one input, the bearing of the goal mapped from [-pi, pi) to [0, 1).
 
-Inputs are ordered: rangefinders, then goal sectors, then goal bearing.
+Motion (odometry): one input, how far the robot's centre moved over the last ``window``
+seconds, ``|p(t) - p(t - window)| / distance`` clipped to [0, 1], so 0 means it has not
+moved (stuck, or turning on the spot) and 1 that it moved ``distance`` or more. Before a
+whole window has passed, ``p(t - window)`` is the first pose seen.
+
+Inputs are ordered: rangefinders, then goal sectors, then goal bearing, then motion.
 """
 
 from __future__ import annotations
@@ -73,19 +78,49 @@ class GoalSectorLayout:
 
 
 @dataclass(frozen=True)
+class MotionLayout:
+    """The motion input: distance moved over a window of odometry (docs/design.md section 5)."""
+
+    window: float  # s, how far back the pose compared with lies
+    distance: float  # m moved over the window that reads as 1
+
+    @property
+    def window_ns(self) -> int:
+        """The window in ns, as odometry stamps count time."""
+        return round(self.window * 1e9)
+
+    def cycles(self, period: float) -> int:
+        """The window in control cycles of ``period`` s.
+
+        Raises:
+            ValueError: a window that is not a whole number of cycles: offline episodes
+                compare positions whole cycles apart, which is what the odometry stamps
+                of a lockstep graph give onboard only then.
+        """
+        cycles = round(self.window / period)
+        if cycles < 1 or abs(cycles * period - self.window) > 1e-9:
+            raise ValueError(
+                f"motion.window must be a whole number of {period:g} s control cycles, "
+                f"got {self.window:g} s"
+            )
+        return cycles
+
+
+@dataclass(frozen=True)
 class SensorLayout:
     """Every input of an arbitrator, in order."""
 
     rangefinders: RangefinderLayout | None = None
     goal_sectors: GoalSectorLayout | None = None
     goal_bearing: bool = False
+    motion: MotionLayout | None = None
 
     @property
     def n_inputs(self) -> int:
         """Number of network inputs."""
         n = len(self.rangefinders.angles) if self.rangefinders else 0
         n += len(self.goal_sectors.centres) if self.goal_sectors else 0
-        return n + int(self.goal_bearing)
+        return n + int(self.goal_bearing) + int(self.motion is not None)
 
     def input_names(self) -> list[str]:
         """A name per input, e.g. ``range_060`` or ``goal_sector_090``."""
@@ -98,6 +133,8 @@ class SensorLayout:
             ]
         if self.goal_bearing:
             names.append("goal_bearing")
+        if self.motion:
+            names.append("motion")
         return names
 
     def to_dict(self) -> dict:
@@ -119,6 +156,9 @@ class SensorLayout:
             }
         if self.goal_bearing:
             out["goal_bearing"] = True
+        # Only when set: the layouts without it keep their fingerprints.
+        if self.motion:
+            out["motion"] = {"window": self.motion.window, "distance": self.motion.distance}
         return out
 
     def fingerprint(self) -> str:
@@ -135,7 +175,7 @@ class SensorLayout:
         """
         if not isinstance(data, dict):
             raise ConfigError(f"{source}: expected a mapping")
-        unknown = set(data) - {"rangefinders", "goal_sectors", "goal_bearing"}
+        unknown = set(data) - {"rangefinders", "goal_sectors", "goal_bearing", "motion"}
         if unknown:
             raise ConfigError(f"{source}: unknown key {sorted(unknown)[0]!r}")
         rf = gs = None
@@ -181,7 +221,14 @@ class SensorLayout:
         bearing = data.get("goal_bearing", False)
         if not isinstance(bearing, bool):
             raise ConfigError(f"{source}: goal_bearing must be true or false")
-        layout = cls(rf, gs, bearing)
+        motion = None
+        if "motion" in data:
+            d = _mapping(data["motion"], "motion", source, {"window", "distance"})
+            motion = MotionLayout(
+                window=_positive(d.get("window"), "motion.window", source),
+                distance=_positive(d.get("distance"), "motion.distance", source),
+            )
+        layout = cls(rf, gs, bearing, motion)
         if layout.n_inputs == 0:
             raise ConfigError(f"{source}: the layout has no inputs")
         return layout
@@ -265,6 +312,14 @@ def tiling_sector(bearing: float, first_centre: float, width: float, n: int) -> 
 def goal_bearing_reading(bearing: float) -> float:
     """The goal bearing (rad, body frame) mapped from [-pi, pi) onto [0, 1)."""
     return ((bearing + math.pi) % (2.0 * math.pi)) / (2.0 * math.pi)
+
+
+def motion_reading(dx: float, dy: float, distance: float) -> float:
+    """The motion input for a displacement ``(dx, dy)`` (m) over the window: 0 to 1.
+
+    Scalar and plain ``math`` so that the compiled simulator uses the same formula.
+    """
+    return min(math.sqrt(dx * dx + dy * dy) / distance, 1.0)
 
 
 def rangefinder_readings(distances: np.ndarray, layout: RangefinderLayout) -> np.ndarray:

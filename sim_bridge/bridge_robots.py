@@ -140,7 +140,9 @@ class FourWSBridge(KinematicBridge):
         wheel = self.commands["wheel"]
         if steering is None:
             steering = self.world.steering
-        speed = 0.0 if wheel is None else float(np.mean(wheel)) * self.wheel_radius
+        # fsum is exact for the executor's four equal wheel speeds, so the speed is
+        # (v / r) x r, the round trip offline episodes apply (docs/design.md section 2).
+        speed = 0.0 if wheel is None else math.fsum(wheel) / len(wheel) * self.wheel_radius
         return np.concatenate([[speed], steering])
 
     def advance(self) -> None:

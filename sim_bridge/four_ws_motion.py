@@ -61,6 +61,17 @@ def motion_limits(geometry: FourWSGeometry) -> MotionLimits:
     )
 
 
+@nb.njit(cache=True)
+def speed_through_wheels(speed, wheel_radius):
+    """The speed (m/s) as the bridge gets it back from wheel velocities: (speed / r) x r.
+
+    Onboard the executor sends speed / r (rad/s) and the bridge multiplies by r, which can
+    move the speed by one ulp; maze episodes apply the same round trip so that a lockstep
+    graph reproduces them bit for bit (docs/design.md section 2).
+    """
+    return (speed / wheel_radius) * wheel_radius
+
+
 @nb.njit(cache=True, inline="always")
 def _approach(value, target, max_step):
     """Move ``value`` towards ``target`` by at most ``max_step``."""

@@ -21,6 +21,7 @@ range_reading = nb.njit(cache=True)(onboard.range_reading)
 in_sector = nb.njit(cache=True)(onboard.in_sector)
 tiling_sector = nb.njit(cache=True)(onboard.tiling_sector)
 goal_bearing_reading = nb.njit(cache=True)(onboard.goal_bearing_reading)
+motion_reading = nb.njit(cache=True)(onboard.motion_reading)
 
 
 class CompiledLayout(NamedTuple):
@@ -31,7 +32,9 @@ class CompiledLayout(NamedTuple):
         max_range, mount_radius: m.
         sector_centres: ``(n_sectors,)`` rad; ``sector_width`` rad; ``sector_tiles`` 1 if
             the sectors tile the circle (one index per bearing), else 0.
-        goal_bearing: 1 if the layout ends with a goal-bearing input, else 0.
+        goal_bearing: 1 if the layout has a goal-bearing input, else 0.
+        motion_cycles: the motion input's window in control cycles; 0: no motion input.
+        motion_distance: m moved over the window that reads as 1.
         n_inputs: number of arbitrator inputs.
     """
 
@@ -42,6 +45,8 @@ class CompiledLayout(NamedTuple):
     sector_width: float
     sector_tiles: int
     goal_bearing: int
+    motion_cycles: int
+    motion_distance: float
     n_inputs: int
 
     def reach(self) -> float:
@@ -49,8 +54,13 @@ class CompiledLayout(NamedTuple):
         return self.mount_radius + self.max_range
 
 
-def compile_layout(layout: SensorLayout) -> CompiledLayout:
-    """The arrays of ``layout``."""
+def compile_layout(layout: SensorLayout, period: float = 0.1) -> CompiledLayout:
+    """The arrays of ``layout`` for episodes of ``period`` s control cycles.
+
+    Raises:
+        ValueError: a motion window of no whole number of cycles
+            (:meth:`~evorbc_ros.sensors.MotionLayout.cycles`).
+    """
     rf = layout.rangefinders
     gs = layout.goal_sectors
     return CompiledLayout(
@@ -61,17 +71,20 @@ def compile_layout(layout: SensorLayout) -> CompiledLayout:
         sector_width=float(gs.width) if gs else 0.0,
         sector_tiles=int(bool(gs and gs.tiles)),
         goal_bearing=int(layout.goal_bearing),
+        motion_cycles=layout.motion.cycles(period) if layout.motion else 0,
+        motion_distance=float(layout.motion.distance) if layout.motion else 1.0,
         n_inputs=layout.n_inputs,
     )
 
 
 @nb.njit(cache=True)
-def read_sensors(x, y, heading, tx, ty, layout, boxes, candidates, out):
+def read_sensors(x, y, heading, tx, ty, rx, ry, layout, boxes, candidates, out):
     """Write the arbitrator inputs of a robot at pose ``(x, y, heading)`` into ``out``.
 
-    ``(tx, ty)`` is the goal (m, world); ``layout`` a :class:`CompiledLayout`. Rangefinder
-    rays start at the mount point on the body's edge; goal sectors and bearing come from
-    the goal's bearing in the body frame.
+    ``(tx, ty)`` is the goal (m, world); ``(rx, ry)`` the position a motion input compares
+    with (one window ago, or the episode's first; unread without one); ``layout`` a
+    :class:`CompiledLayout`. Rangefinder rays start at the mount point on the body's edge;
+    goal sectors and bearing come from the goal's bearing in the body frame.
     """
     # Fields as locals: numba does not hoist NamedTuple loads out of the loops.
     ray_angles, max_range, mount = layout.ray_angles, layout.max_range, layout.mount_radius
@@ -101,3 +114,6 @@ def read_sensors(x, y, heading, tx, ty, layout, boxes, candidates, out):
         n += n_sectors
         if layout.goal_bearing:
             out[n] = goal_bearing_reading(bearing)
+            n += 1
+    if layout.motion_cycles > 0:
+        out[n] = motion_reading(x - rx, y - ry, layout.motion_distance)

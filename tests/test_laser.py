@@ -185,7 +185,7 @@ def test_simulated_laser_gives_the_offline_readings():
             ranges = world.scan().astype(np.float32)
             laser = world.laser
             got = converter.readings(laser.angle_min, laser.increment, ranges, 0.0, laser.range_max)
-            read_sensors(x, y, h, *maze.target, c, maze.boxes, every, out)
+            read_sensors(x, y, h, *maze.target, x, y, c, maze.boxes, every, out)
             np.testing.assert_allclose(got, out[:6], atol=1e-4)  # 0.1 mm of 1 m
     finally:
         world.close()

@@ -17,7 +17,7 @@ from offline_evolution.maze_task.task import (
     evorbc_controller,
     standard_controller,
 )
-from sim_bridge.four_ws_motion import STATE_SIZE, step_robot
+from sim_bridge.four_ws_motion import STATE_SIZE, speed_through_wheels, step_robot
 from sim_bridge.sensors import read_sensors
 
 CORRIDOR = {
@@ -120,10 +120,12 @@ def test_kernel_matches_the_onboard_controller_cycle_by_cycle(five_maze_task, sm
             for t in range(int(result.cycles[e])):
                 x, y, h = state[0, :3]
                 np.testing.assert_array_equal(result.pose[e, t], state[0, :3])
-                read_sensors(x, y, h, tx, ty, s, boxes, every, inputs)
+                read_sensors(x, y, h, tx, ty, x, y, s, boxes, every, inputs)
                 choice, _ = onboard.choose(inputs)
                 assert choice == result.choice[e, t], (g, j, t)
-                command = controller.primitive_commands[choice]
+                command = controller.primitive_commands[choice].copy()
+                # The speed as onboard, through wheel rad/s (docs/design.md section 2).
+                command[0] = speed_through_wheels(command[0], task.robot.speed_wheel_radius)
                 step_robot(state, 0, command, task.robot.limits, boxes, every)
 
 
@@ -176,6 +178,15 @@ def test_episodes_that_reach_a_fixed_point_end_with_the_full_episodes_outcome(sm
             evorbc_controller(small_repertoire, "polar", task.robot),
         ),
     ]
+    moving, settled = compare_early_ends(task, cases, starts, still_cycles=200)
+    # Both kinds of episode were there to compare.
+    assert moving >= 10 and settled >= 10
+
+
+def compare_early_ends(task, cases, starts, still_cycles):
+    """Assert that each ``(networks, controller)`` case ends its episodes with the outcome
+    of recorded (never early-ended) episodes; returns how many were still moving at the end
+    and how many stood still over their last ``still_cycles`` cycles."""
     moving = settled = 0
     for networks, controller in cases:
         fast = task.evaluate(networks, controller, starts)
@@ -184,6 +195,6 @@ def test_episodes_that_reach_a_fixed_point_end_with_the_full_episodes_outcome(sm
             assert np.array_equal(getattr(fast, field), getattr(full, field)), field
         last_step = np.any(full.pose[:, -1] != full.pose[:, -2], axis=1) & ~full.reached
         moving += int(last_step.sum())
-        settled += int(np.sum(np.all(full.pose[:, -1] == full.pose[:, -200], axis=1)))
-    # Both kinds of episode were there to compare.
-    assert moving >= 10 and settled >= 10
+        still = np.all(full.pose[:, -1] == full.pose[:, -still_cycles], axis=1)
+        settled += int(np.sum(still))
+    return moving, settled

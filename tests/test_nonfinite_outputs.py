@@ -240,7 +240,7 @@ def test_offline_replay_stands_still_and_counts_the_stopped_cycles(task, edit):
 def test_the_kernel_stops_like_the_onboard_controller_cycle_by_cycle(task):
     """A network that drives, then stops near a wall: the compiled kernel and the onboard
     controller (pure Python) choose the same, no-primitive cycles included."""
-    from sim_bridge.four_ws_motion import STATE_SIZE, step_robot
+    from sim_bridge.four_ws_motion import STATE_SIZE, speed_through_wheels, step_robot
     from sim_bridge.sensors import read_sensors
 
     arb = edited(ARB, stop_near_walls)
@@ -261,13 +261,17 @@ def test_the_kernel_stops_like_the_onboard_controller_cycle_by_cycle(task):
         command = np.zeros(5)
         for t in range(int(result.cycles[e])):
             np.testing.assert_array_equal(result.pose[e, t], state[0, :3])
-            read_sensors(*state[0, :3], *maze.target, task.sensors, maze.boxes, every, inputs)
+            read_sensors(
+                *state[0, :3], *maze.target, *state[0, :2], task.sensors, maze.boxes, every, inputs
+            )
             choice, _ = onboard.choose(inputs)
             assert choice == result.choice[e, t], (e, t)
             if choice == NO_PRIMITIVE:
                 command[0] = 0.0  # the executor's stop: steering held
             else:
                 command = controller.primitive_commands[choice].copy()
+                # The speed as onboard, through wheel rad/s (docs/design.md section 2).
+                command[0] = speed_through_wheels(command[0], task.robot.speed_wheel_radius)
             step_robot(state, 0, command, task.robot.limits, maze.boxes, every)
 
 

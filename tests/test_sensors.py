@@ -49,7 +49,7 @@ def read(x, y, heading, goal=FAR_GOAL, boxes=ROOM, layout=COMPILED, candidates=N
     if candidates is None:
         candidates = np.arange(len(boxes), dtype=np.int64)
     out = np.full(layout.n_inputs, np.nan)
-    read_sensors(x, y, heading, goal[0], goal[1], layout, boxes, candidates, out)
+    read_sensors(x, y, heading, goal[0], goal[1], x, y, layout, boxes, candidates, out)
     assert not np.isnan(out).any()  # every input was written
     return out
 

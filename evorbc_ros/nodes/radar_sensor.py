@@ -1,5 +1,9 @@
 """``radar_sensor``: robot pose and goal -> goal-sector (4WS) or goal-bearing readings.
 
+A layout with a motion input (docs/design.md section 5) gets it here too, appended: the
+distance moved over its window, timed by the odometry's header stamps (a stamp earlier
+than the last starts the window again).
+
 Subscribes ``odom`` (nav_msgs/Odometry, sensor-data QoS) and ``goal``
 (geometry_msgs/PointStamped, or PoseStamped with ``goal_type: pose``); publishes
 ``evorbc/goal_sectors`` (std_msgs/Float64MultiArray, reliable) on every odometry message
@@ -104,7 +108,10 @@ class RadarSensorNode(Node):
         try:
             q = pose.orientation
             yaw = yaw_from_quaternion(q.x, q.y, q.z, q.w)
-            readings = self.inputs.readings(pose.position.x, pose.position.y, yaw, gx, gy)
+            stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+            readings = self.inputs.readings(
+                pose.position.x, pose.position.y, yaw, gx, gy, stamp_ns=stamp
+            )
         except InputError as e:
             self.get_logger().warning(
                 f"{self.odom_topic}: skipped a pose: {e}", throttle_duration_sec=2.0

@@ -185,6 +185,11 @@ class MazeTaskBase(abc.ABC):
         #: The generated mazes drawn from (:meth:`start_training`), or None.
         self.training: TrainingMazes | None = None
         self.layout = SensorLayout.load(config_dir() / settings.sensors)
+        if self.layout.motion is not None:
+            try:
+                self.layout.motion.cycles(dt)
+            except ValueError as e:
+                raise ConfigError(f"sensors: {settings.sensors}: {e}") from None
         self.dt = dt
         self.n_cycles = control_steps(settings.episode_time, dt)
         self.footprint_radius = footprint_radius

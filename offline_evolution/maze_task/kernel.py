@@ -13,6 +13,9 @@ no primitive, as onboard (:func:`evorbc_ros.mapping.choose_primitive`, the execu
 message): zero wheel speed with the steering held at its last command (4WS), a zero twist
 (differential drive).
 
+A motion input (docs/design.md section 5) compares the position with the one ``W`` cycles
+earlier (the episode's first before that), kept in a ring of the last ``W + 1`` positions.
+
 Episodes are independent, so results do not depend on the number of threads. A recurrent
 network (docs/design.md section 8) keeps its state in its episode's own two value buffers,
 carried from cycle to cycle and 0 at the start of the episode.
@@ -33,7 +36,7 @@ import numpy as np
 
 from evorbc_ros import mapping as onboard_mapping
 from offline_evolution.arbitrator.compiled import activate, activate_recurrent
-from sim_bridge.four_ws_motion import HEADING, STATE_SIZE, X, Y
+from sim_bridge.four_ws_motion import HEADING, STATE_SIZE, X, Y, speed_through_wheels
 from sim_bridge.geometry import grid_candidates
 from sim_bridge.kinematics import halt, step_model
 from sim_bridge.sensors import read_sensors
@@ -174,7 +177,9 @@ def run_episodes(
     lookup_origin, lookup_cell = controller.lookup_origin, controller.lookup_cell
     lookup_table, primitive_commands = controller.lookup_table, controller.primitive_commands
     gene_matrix, command_scale = controller.gene_matrix, controller.command_scale
+    wheel_radius = controller.speed_wheel_radius
     n_rangefinders = sensors.ray_angles.shape[0]
+    window = sensors.motion_cycles  # 0: no motion input
     # Entries of a command: the robot's (4WS 5, differential drive 2).
     width = primitive_commands.shape[1] if mode == EVORBC else gene_matrix.shape[1]
     for e in nb.prange(n_ep):
@@ -205,14 +210,23 @@ def run_episodes(
         # Commands still on their way to the wheels (latency): a ring of the last ones,
         # starting as stops with the steering straight.
         pending = np.zeros((max(latency, 1), width))
+        # The motion input's ring: position of cycle t in row t % (window + 1) (m).
+        trail = np.empty((window + 1, 2))
+        still = 0  # cycles in a row whose step left the state unchanged
         initial_distance[e] = math.hypot(start[e, 0] - tx, start[e, 1] - ty)
         dist = initial_distance[e]
         for t in range(n_cycles):
             x = state[e, X]
             y = state[e, Y]
             h = state[e, HEADING]
+            rx, ry = x, y
+            if window > 0:
+                trail[t % (window + 1), 0] = x
+                trail[t % (window + 1), 1] = y
+                ref = max(t - window, 0) % (window + 1)
+                rx, ry = trail[ref, 0], trail[ref, 1]
             cand = _candidates(m, x, y, world)
-            read_sensors(x, y, h, tx, ty, sensors, boxes, cand, inputs)
+            read_sensors(x, y, h, tx, ty, rx, ry, sensors, boxes, cand, inputs)
             if noise_sd > 0.0 or dropout > 0.0:
                 _perturb_readings(inputs, n_rangefinders, noise_sd, dropout, key, t)
             if recurrent:
@@ -237,6 +251,8 @@ def run_episodes(
                         gene = 2.0 * min(max(out[k], 0.0), 1.0) - 1.0
                         acc += gene * gene_matrix[k, c]
                     command[c] = acc * command_scale[c]
+            if finite and wheel_radius > 0.0:
+                command[0] = speed_through_wheels(command[0], wheel_radius)
             if not finite:
                 choice = NO_PRIMITIVE
                 halt(command, lim)  # no primitive: stop
@@ -274,16 +290,19 @@ def run_episodes(
                 # unchanged, so every later cycle reads the same sensors, gets the same
                 # outputs from the network and makes the same step. A feed-forward network
                 # is stateless; a recurrent one must also have written the values it read
-                # (both buffers equal), so its next step repeats this one. The episode's
-                # outcome is already known: stop here.
+                # (both buffers equal), so its next step repeats this one. A motion input
+                # reads the same (0) only once the whole window, and the position this
+                # cycle compared with, hold this position: more than ``window`` unchanged
+                # steps in a row. The episode's outcome is already known: stop here.
                 same = True
                 for k in range(STATE_SIZE):
                     if state[e, k] != before[k]:
                         same = False
                         break
+                still = still + 1 if same else 0
                 if same and recurrent:
                     same = _same_state(buffers, net_slots[g])
-                if same:
+                if same and still > window:
                     break
         final_distance[e] = dist
         end[e, 0] = state[e, X]

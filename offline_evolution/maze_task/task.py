@@ -75,6 +75,9 @@ class ControllerArrays(NamedTuple):
     primitive_commands: np.ndarray  # (n_primitives, w)
     gene_matrix: np.ndarray  # (n_genes, w)
     command_scale: np.ndarray  # (w,)
+    # m: the speed (entry 0) goes through (speed / r) x r, as onboard via wheel rad/s; 0:
+    # none (docs/design.md section 2).
+    speed_wheel_radius: float
 
 
 def evorbc_controller(
@@ -95,6 +98,7 @@ def evorbc_controller(
         np.ascontiguousarray(commands),
         np.zeros((1, width)),
         np.zeros(width),
+        float(robot.speed_wheel_radius),
     )
 
 
@@ -111,6 +115,7 @@ def standard_controller(robot: KinematicRobot) -> ControllerArrays:
         np.zeros((1, width)),
         np.ascontiguousarray(robot.gene_matrix, dtype=np.float64),
         np.asarray(robot.command_scale, dtype=np.float64),
+        float(robot.speed_wheel_radius),
     )
 
 
@@ -137,7 +142,7 @@ class MazeTask(MazeTaskBase):
             robot = lookup(robot).make_simulation()
         self.robot = robot
         super().__init__(settings, robot.control_period, robot.footprint_radius, robot.name)
-        self.sensors = compile_layout(self.layout)
+        self.sensors = compile_layout(self.layout, robot.control_period)
         # Walls a ray or the footprint can touch from a cell: sensor reach plus a step and
         # a margin (m).
         self.reach = self.sensors.reach() + 0.1

@@ -137,11 +137,13 @@ class EpisodeRunner:
         world: dict | None = None,
         cycle: int = 0,
     ) -> np.ndarray:
-        """The arbitrator's inputs now: laser groups, then goal bearing.
+        """The arbitrator's inputs now: laser groups, then goal bearing (and motion).
 
         ``base``: the body's :meth:`~LeggedSim.base_pose` read since the last step, or
         None to read it now. ``world``, ``cycle``: a perturbed world's row and the cycle
-        (laser noise and dropouts, :func:`~sim_bridge.legged.perturbed.perturbed_ranges`).
+        (laser noise and dropouts, :func:`~sim_bridge.legged.perturbed.perturbed_ranges`);
+        the cycle also stamps the pose for a motion input, as the bridge stamps its
+        odometry (``round(cycle x period)`` ns).
         """
         base = sim.base_pose() if base is None else base
         s = self.scanner
@@ -149,7 +151,8 @@ class EpisodeRunner:
         rf = self.laser.readings(s.angle_min, s.angle_increment, ranges, s.range_min, s.range_max)
         (x, y, _), orn = base
         yaw = yaw_from_quaternion(*orn)
-        goal = self.goal.readings(x, y, yaw, maze.target[0], maze.target[1])
+        stamp = round(cycle * self.world.settings.control_period * 1e9)
+        goal = self.goal.readings(x, y, yaw, maze.target[0], maze.target[1], stamp_ns=stamp)
         return np.concatenate([rf, goal])
 
     def run(
@@ -175,8 +178,10 @@ class EpisodeRunner:
         """
         maze, sim = self.sims.get(maze_index)  # a task maze's index or a generated maze
         sim.reset(*start)
-        # A fresh compile per episode: a recurrent network's state starts at 0 here.
+        # A fresh compile per episode: a recurrent network's state starts at 0 here; so
+        # does a motion input's window.
         net = network.compile()
+        self.goal.reset()
         chooser = self.chooser(controller)
         tx, ty = maze.target
         # The body's pose is read once per cycle (a PyBullet state request each time) and

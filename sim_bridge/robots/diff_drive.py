@@ -32,6 +32,7 @@ class DiffDriveRobot:
         #: A standard controller's outputs are the genes: one per command entry.
         self.gene_matrix = np.eye(2)
         self.command_scale = geometry.command_scale
+        self.speed_wheel_radius = 0.0  # a twist reaches the bridge as it is: no round trip
 
     @property
     def parameter_specs(self) -> tuple[ParameterSpec, ...]:

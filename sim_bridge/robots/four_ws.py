@@ -25,6 +25,11 @@ class FourWSRobot:
         self.gene_matrix = self.type.gene_matrix
         g = self.geometry
         self.command_scale = np.array([g.max_speed] + [g.max_wheel_angle] * 4)
+        #: m: onboard the speed travels as wheel rad/s (speed / r) and the bridge turns it
+        #: back (x r), which can move it by one ulp; maze episodes apply the same round
+        #: trip so that the lockstep graph reproduces them bit for bit (docs/design.md
+        #: section 2). Primitive evaluation (MAP-Elites) does not: no ROS interface there.
+        self.speed_wheel_radius = g.wheel_radius
 
     def commands(self, genes: np.ndarray) -> np.ndarray:
         """``(n, 5)`` wheel commands (speed m/s, fl, fr, rl, rr rad) of ``(n, d)`` genes."""
