@@ -128,7 +128,7 @@ def switching_arbitrator(task, rep, robot, neat_path, tries=20, evolution=None):
     from evorbc_ros.arbitrator import ArbitratorFile
     from offline_evolution.maze_task.replay import replay
 
-    config = neat_config(6, 2, path=neat_path)
+    config = neat_config(task.layout.n_inputs, 2, path=neat_path)
     for seed in range(tries):
         network = network_spec(random_genomes(config, 1, seed=seed)[0], config)
         arb = ArbitratorFile(

@@ -13,7 +13,7 @@ import yaml
 from graph_helpers import assert_lockstep_reproduces
 
 from evorbc_ros.arbitrator import Arbitrator, ArbitratorFile
-from evorbc_ros.config import ConfigError
+from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.goal import GoalInputs
 from evorbc_ros.motion import MotionWindow
@@ -198,3 +198,40 @@ def test_the_lockstep_graph_reproduces_a_motion_controller_bit_for_bit(tmp_path,
     arb.save(path)
     controller = (str(path), str(rep_path), outcomes[0], result)
     assert_lockstep_reproduces(tmp_path, 179, "4ws-5", "gaps", controller, 25.0)
+
+
+def test_the_lockstep_graph_reproduces_a_hexapod_using_motion_bit_for_bit(tmp_path):
+    """The legged episodes read motion with the radar node's code, the pose stamped as the
+    bridge stamps its odometry: a 4-s hexapod episode whose choices depend on it (without
+    its connections they differ) runs the same through the lockstep graph."""
+    from graph_helpers import switching_arbitrator
+    from hexapod_helpers import tripod_repertoire
+
+    from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
+
+    layout = SensorLayout.load(config_dir() / "sensors" / "hexapod.yaml")
+    layout = dataclasses.replace(layout, motion=MotionLayout(window=1.0, distance=0.05))
+    path = tmp_path / "hexapod-motion.yaml"
+    path.write_text(yaml.safe_dump(layout.to_dict()))
+    rep = tripod_repertoire()
+    rep_path = tmp_path / "hexapod.repertoire.json"
+    rep.save(rep_path)
+    task = HexapodMazeTask(MazeTaskSettings(("hexapod",), 4.0, 1, str(path)), workers=1)
+    try:
+        arb, outcome, result = switching_arbitrator(task, rep, "hexapod", "config/neat/hexapod.ini")
+        motion_key = arb.network.input_keys[-1]
+        cut = dataclasses.replace(
+            arb.network,
+            connections=tuple(
+                dataclasses.replace(c, weight=0.0) if c.source == motion_key else c
+                for c in arb.network.connections
+            ),
+        )
+        _, without = replay(dataclasses.replace(arb, network=cut), task, task.nominal_starts(), rep)
+    finally:
+        task.close()
+    assert not np.array_equal(without.choice, result.choice)
+    arb_path = tmp_path / "hexapod-motion.json"
+    arb.save(arb_path)
+    controller = (arb_path, rep_path, outcome, result)
+    assert_lockstep_reproduces(tmp_path, 176, "hexapod", "hexapod", controller, 4.0)
