@@ -74,6 +74,9 @@ SHIPPED = {
     "4ws-5": {
         "shipped_repertoire": "4ws-5.repertoire.json",
         "shipped_arbitrator": "4ws-5.arbitrator.json",
+        # Trained on the paper's five mazes only (paper Table I); the shipped one also on
+        # generated mazes (evorbc_ros/data/README.md, docs/generalisation.md).
+        "paper_arbitrator": "4ws-5-paper.arbitrator.json",
     }
 }
 
