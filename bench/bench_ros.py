@@ -46,6 +46,21 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / TICKS
 
 
+def random_inputs(layout, rng, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(rangefinders, goal group)`` readings of ``layout``: uniform ranges, goal sector
+    ``k`` mod the sector count lit (or a uniform bearing), a uniform motion reading."""
+    n_rf = len(layout.rangefinders.angles) if layout.rangefinders else 0
+    goal = []
+    if layout.goal_sectors:
+        n = len(layout.goal_sectors.centres)
+        goal += list(np.eye(n)[k % n])
+    if layout.goal_bearing:
+        goal.append(rng.uniform(0, 1))
+    if layout.motion:
+        goal.append(rng.uniform(0, 1))
+    return rng.uniform(0, 1, n_rf), np.array(goal)
+
+
 def arbitrator_latency(cycles: int = 2000) -> tuple[list[float], list[float]]:
     """Seconds from the completing input to the primitive, and of the pure choice."""
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "OFF"
@@ -77,12 +92,13 @@ def arbitrator_latency(cycles: int = 2000) -> tuple[list[float], list[float]]:
     rng = np.random.default_rng(0)
     latencies = []
     for k in range(cycles):
-        rf.publish(vector_message(rng.uniform(0, 1, 6)))
+        ranges, goal = random_inputs(node.controller.spec.sensors, rng, k)
+        rf.publish(vector_message(ranges))
         while node.groups.fresh.get("evorbc/rangefinders") is not True:
             executor.spin_once(timeout_sec=0.01)
         n = len(got)
         start = time.perf_counter()
-        gs.publish(vector_message(np.eye(4)[k % 4]))
+        gs.publish(vector_message(goal))
         while len(got) == n:
             executor.spin_once(timeout_sec=0.01)
         latencies.append(got[-1] - start)
@@ -93,7 +109,7 @@ def arbitrator_latency(cycles: int = 2000) -> tuple[list[float], list[float]]:
     controller = Controller()
     pure = []
     for _ in range(cycles):
-        x = np.concatenate([rng.uniform(0, 1, 6), np.eye(4)[rng.integers(4)]])
+        x = np.concatenate(random_inputs(controller.spec.sensors, rng, int(rng.integers(8))))
         t0 = time.perf_counter()
         controller.step(x)
         pure.append(time.perf_counter() - t0)
