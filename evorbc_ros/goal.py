@@ -57,11 +57,11 @@ class GoalInputs:
         return self.layout.input_names()[n_range:]
 
     def readings(
-        self, x: float, y: float, yaw: float, gx: float, gy: float, stamp_ns: int = 0
+        self, x: float, y: float, yaw: float, gx: float, gy: float, stamp_ns: int | None = None
     ) -> np.ndarray:
         """Readings for a robot at ``(x, y, yaw)`` and a goal at ``(gx, gy)`` (one frame).
 
-        ``stamp_ns``: the pose's time (ns), read only by a motion input.
+        ``stamp_ns``: the pose's time (ns), which a motion input needs (ValueError without).
 
         Raises:
             InputError: a non-finite pose or goal (the motion window keeps no such pose).
@@ -76,5 +76,7 @@ class GoalInputs:
         if self.layout.goal_bearing:
             out.append(goal_bearing_reading(bearing))
         if self.motion is not None:
+            if stamp_ns is None:
+                raise ValueError("the layout's motion input needs the pose's stamp")
             out.append(self.motion.reading(stamp_ns, x, y))
         return np.array(out, dtype=np.float64)

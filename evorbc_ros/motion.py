@@ -24,7 +24,9 @@ class MotionWindow:
     The reading compares the newest position with the newest one stamped at least
     ``window`` earlier, or with the first position seen while less than a window has
     passed. A stamp earlier than the last one (a simulation reset, a restarted
-    odometry source) starts the window again, as does :meth:`reset`.
+    odometry source) starts the window again, as does :meth:`reset`. A pose stamped as the
+    last one replaces it (:attr:`repeated` says so): odometry whose stamps never advance
+    reads 0 and keeps one pose, rather than piling up poses for ever.
     """
 
     def __init__(self, layout: MotionLayout):
@@ -32,6 +34,8 @@ class MotionWindow:
         self.window_ns = layout.window_ns
         # (stamp ns, x m, y m), oldest first; the first entry is the reference position.
         self.poses: collections.deque[tuple[int, float, float]] = collections.deque()
+        #: True if the last pose had the same stamp as the one before (it replaced it).
+        self.repeated = False
 
     def reset(self) -> None:
         """Forget every pose (a new episode)."""
@@ -41,6 +45,9 @@ class MotionWindow:
         """Add the position ``(x, y)`` (m, a fixed frame) at ``stamp_ns``; its reading, 0-1."""
         if self.poses and stamp_ns < self.poses[-1][0]:
             self.poses.clear()
+        self.repeated = bool(self.poses) and stamp_ns == self.poses[-1][0]
+        if self.repeated:
+            self.poses.pop()
         self.poses.append((stamp_ns, x, y))
         # Keep the newest pose at least a window old as the reference, and nothing older.
         cutoff = stamp_ns - self.window_ns

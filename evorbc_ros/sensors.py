@@ -98,10 +98,12 @@ class MotionLayout:
                 of a lockstep graph give onboard only then.
         """
         cycles = round(self.window / period)
-        if cycles < 1 or abs(cycles * period - self.window) > 1e-9:
+        # Exact in ns, the unit of the stamps onboard: a window a nanosecond off would
+        # compare with another pose there than here.
+        if cycles < 1 or self.window_ns != cycles * round(period * 1e9):
             raise ValueError(
                 f"motion.window must be a whole number of {period:g} s control cycles, "
-                f"got {self.window:g} s"
+                f"got {self.window!r} s"
             )
         return cycles
 

@@ -58,14 +58,31 @@ def test_a_bad_motion_entry_is_one_line_naming_the_key(motion, message):
         SensorLayout.from_dict({**LAYOUT, "motion": motion}, "layout.yaml")
 
 
-def test_a_task_refuses_a_window_of_no_whole_control_cycles(tmp_path):
+@pytest.mark.parametrize("window", [0.25, 0.3000000006])
+def test_a_task_refuses_a_window_of_no_whole_control_cycles(tmp_path, window):
+    # 0.3000000006 s is 1 ns more than 3 cycles: onboard stamps (ns) would compare with
+    # another pose than the kernel, so it is refused too.
     path = tmp_path / "odd.yaml"
-    path.write_text(yaml.safe_dump({**LAYOUT, "motion": {"window": 0.25, "distance": 0.1}}))
+    path.write_text(yaml.safe_dump({**LAYOUT, "motion": {"window": window, "distance": 0.1}}))
     with pytest.raises(ConfigError) as e:
         MazeTask(MazeTaskSettings(("gaps",), 10.0, 1, str(path)), "4ws-5")
     assert str(e.value) == (
-        f"sensors: {path}: motion.window must be a whole number of 0.1 s control cycles, got 0.25 s"
+        f"sensors: {path}: motion.window must be a whole number of 0.1 s control cycles, "
+        f"got {window!r} s"
     )
+
+
+def test_a_layout_differing_only_in_its_motion_settings_is_named_by_them():
+    from evorbc_ros.arbitrator import ArbitratorError
+
+    arb = motion_arbitrator(0.0)
+    other = dataclasses.replace(arb.sensors, motion=MotionLayout(window=2.0, distance=0.1))
+    with pytest.raises(ArbitratorError) as e:
+        arb.check_sensors(other, "mine.yaml")
+    assert "sensor layout mine.yaml differs from the arbitrator's (motion: " in str(e.value)
+    assert "'window': 2.0" in str(e.value) and "'window': 1.0" in str(e.value)
+    with pytest.raises(ValueError, match="needs the pose's stamp"):
+        GoalInputs(arb.sensors).readings(0.0, 0.0, 0.0, 1.0, 1.0)
 
 
 def test_the_window_compares_with_the_pose_a_window_ago_or_the_first():
@@ -85,6 +102,10 @@ def test_the_window_compares_with_the_pose_a_window_ago_or_the_first():
     assert window.reading(0, 7.0, 7.0) == 0.0
     window.reset()
     assert window.reading(SECOND, 1.0, 1.0) == 0.0 and len(window.poses) == 1
+    # Stamps that never advance: each pose replaces the last, so nothing piles up.
+    for k in range(50):
+        window.reading(SECOND, 1.0 + k, 1.0)
+    assert len(window.poses) == 1 and window.repeated
 
 
 def test_irregular_odometry_compares_with_the_newest_pose_at_least_a_window_old():

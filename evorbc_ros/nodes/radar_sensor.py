@@ -2,7 +2,7 @@
 
 A layout with a motion input (docs/design.md section 5) gets it here too, appended: the
 distance moved over its window, timed by the odometry's header stamps (a stamp earlier
-than the last starts the window again).
+than the last, or a new goal, starts the window again; a repeated stamp is logged).
 
 Subscribes ``odom`` (nav_msgs/Odometry, sensor-data QoS) and ``goal``
 (geometry_msgs/PointStamped, or PoseStamped with ``goal_type: pose``); publishes
@@ -87,6 +87,7 @@ class RadarSensorNode(Node):
         goal = (p.x, p.y, msg.header.frame_id)
         if goal != self.goal:
             self.get_logger().info(f"goal ({p.x:.3f}, {p.y:.3f}) in frame '{msg.header.frame_id}'")
+            self.inputs.reset()  # a new goal, a new run: the motion window starts again
         self.goal = goal
 
     def on_odom(self, msg: Odometry) -> None:
@@ -117,6 +118,12 @@ class RadarSensorNode(Node):
                 f"{self.odom_topic}: skipped a pose: {e}", throttle_duration_sec=2.0
             )
             return
+        if self.inputs.motion is not None and self.inputs.motion.repeated:
+            self.get_logger().warning(
+                f"{self.odom_topic}: stamp {stamp} ns repeats the last one; the motion input "
+                "needs odometry stamped as it is measured (it reads 0 meanwhile)",
+                throttle_duration_sec=5.0,
+            )
         self.pub.publish(vector_message(readings, self.inputs.names))
 
 

@@ -211,7 +211,8 @@ def run_episodes(
         # starting as stops with the steering straight.
         pending = np.zeros((max(latency, 1), width))
         # The motion input's ring: position of cycle t in row t % (window + 1) (m).
-        trail = np.empty((window + 1, 2))
+        # (Rows past the episode's length are never written: a longer window reads p(0).)
+        trail = np.empty((min(window, n_cycles) + 1, 2))
         still = 0  # cycles in a row whose step left the state unchanged
         initial_distance[e] = math.hypot(start[e, 0] - tx, start[e, 1] - ty)
         dist = initial_distance[e]
