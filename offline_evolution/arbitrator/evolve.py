@@ -364,19 +364,32 @@ class Evolution:
         """A genome dict (as kept in the hall of fame) as a network."""
         return network_spec(genome_from_dict(genome, self.config), self.config)
 
-    def result(self, seconds: float) -> EvolutionResult:
-        """Post-evaluate the hall of fame and assemble the run's outcome."""
+    def result(
+        self, seconds: float, progress: Callable[[int, int], None] | None = None
+    ) -> EvolutionResult:
+        """Post-evaluate the hall of fame and assemble the run's outcome.
+
+        ``progress``: reports the post-evaluation's episodes as they finish, on a task
+        that reports (``MazeTaskBase.progress``: the legged robots'); ignored otherwise.
+        """
         candidates = self.hall.candidates()
         starts = post_evaluation_starts(self.task, self.settings.seed, self.settings.post_samples)
-        post = post_evaluate(
-            self.task,
-            self.controller,
-            [self.network(g) for g in candidates],
-            starts,
-            self.settings.post_rule,
-            len(self.task.nominal_starts()),
-            validation_rows(self.task, self.settings.post_samples),
-        )
+        reports = progress is not None and hasattr(self.task, "progress")
+        if reports:
+            self.task.progress = progress
+        try:
+            post = post_evaluate(
+                self.task,
+                self.controller,
+                [self.network(g) for g in candidates],
+                starts,
+                self.settings.post_rule,
+                len(self.task.nominal_starts()),
+                validation_rows(self.task, self.settings.post_samples),
+            )
+        finally:
+            if reports:
+                self.task.progress = None
         chosen = candidates[post.index]
         return EvolutionResult(
             settings=self.settings,
@@ -496,6 +509,7 @@ def evolve(
     keep_checkpoint: bool = False,
     task: ArbitratorTask | None = None,
     on_resume: Callable[[int], None] | None = None,
+    post_progress: Callable[[int, int], None] | None = None,
 ) -> EvolutionResult:
     """Run NEAT on a task to the last generation (exported as ``evolve_arbitrator``).
 
@@ -519,6 +533,8 @@ def evolve(
         on_resume: called with the generations already done when the run resumes from
             ``checkpoint`` (before anything runs; also when only the post-evaluation is
             left).
+        post_progress: called as ``(done, total)`` while the post-evaluation's episodes
+            run, on tasks that report (the legged robots': it can take many minutes).
 
     Raises:
         RepertoireError: the repertoire was evolved for another simulated robot.
@@ -546,7 +562,7 @@ def evolve(
                 raise Interrupted(run.generation, None if checkpoint is None else str(checkpoint))
         if checkpoint is not None and keep_checkpoint and saved != run.generation:
             run.save(checkpoint, time.perf_counter() - start)
-        result = run.result(time.perf_counter() - start)
+        result = run.result(time.perf_counter() - start, post_progress)
         if checkpoint is not None and not keep_checkpoint and os.path.exists(checkpoint):
             os.remove(checkpoint)
         return result

@@ -13,6 +13,7 @@ from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.registry import ROBOT_NAMES, lookup
 from offline_evolution.commands.common import (
     CliError,
+    EpisodeProgress,
     add_workers_option,
     at_least,
     check_distinct,
@@ -164,6 +165,7 @@ def _run(args, settings, every: int, repertoire, checkpoint: Path):
             checkpoint_every=every,
             progress=printer,
             on_resume=printer.resumed,
+            post_progress=None if args.quiet else EpisodeProgress("post-evaluation"),
             should_stop=stop,
             workers=args.workers or None,
             repertoire_source=args.repertoire if repertoire else "the repertoire",

@@ -9,6 +9,7 @@ import math
 import os
 import signal
 import sys
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -104,6 +105,54 @@ def running(step: str, unit: str) -> Iterator[StopOnSignal]:
         ) from None
     finally:
         stop.restore(previous)
+
+
+class EpisodeProgress:
+    """Progress of a long batch of episodes, as lines on stderr.
+
+    Called as ``(done, total)`` (``MazeTaskBase.progress``). Says nothing for the first
+    ``every`` seconds of a batch, so a batch that runs in seconds (every 4WS one) prints
+    nothing; then a line at most every ``every`` seconds and one when the batch is done:
+    ``post-evaluation: 340/1785 episodes (19 %), 2.1 min, eta 8.9 min``.
+
+    Args:
+        label: what the batch is.
+        every: s between lines.
+        clock: s, monotonic (a parameter for tests).
+        stream: where lines go (default ``sys.stderr`` at the time of the call).
+    """
+
+    def __init__(
+        self,
+        label: str,
+        every: float = 10.0,
+        clock: Callable[[], float] | None = None,
+        stream=None,
+    ) -> None:
+        self.label = label
+        self.every = every
+        self.clock = clock or time.monotonic
+        self.stream = stream
+        self.start = 0.0
+        self.last = 0.0
+
+    def __call__(self, done: int, total: int) -> None:
+        """``done`` of ``total`` episodes have finished; ``done == 0`` starts a batch."""
+        now = self.clock()
+        if done == 0:
+            self.start = self.last = now
+            return
+        elapsed = now - self.start
+        finished = done >= total
+        if elapsed < self.every or (now - self.last < self.every and not finished):
+            return
+        self.last = now
+        tail = "done" if finished else f"eta {elapsed / done * (total - done) / 60:.1f} min"
+        print(
+            f"{self.label}: {done}/{total} episodes ({100 * done / total:.0f} %), "
+            f"{elapsed / 60:.1f} min, {tail}",
+            file=self.stream or sys.stderr,
+        )
 
 
 def add_workers_option(parser: argparse.ArgumentParser) -> None:

@@ -20,7 +20,7 @@ from evorbc_ros.defaults import (
     ships_controller,
 )
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
-from offline_evolution.commands.common import CliError, at_least, count
+from offline_evolution.commands.common import CliError, EpisodeProgress, at_least, count
 from offline_evolution.commands.replay import check_task, controller_inputs
 from offline_evolution.mazes.held_out import HELD_OUT_SEED  # never trained on
 
@@ -163,6 +163,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     try:
         check_task(task, arb, arb_path, repertoire, rep_path, args.allow_mismatch)
         controller = task.controller(arb.kind, repertoire, arb.mapping)
+        task.progress = EpisodeProgress("evaluate")  # PyBullet suites take minutes
         try:
             suite = evaluate_suite(
                 task, arb.network, controller, args.starts, args.seed, perturbation

@@ -14,7 +14,7 @@ from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.defaults import default_repertoire
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.registry import lookup
-from offline_evolution.commands.common import CliError, at_least, count
+from offline_evolution.commands.common import CliError, EpisodeProgress, at_least, count
 from sim_bridge.robots.design import check_simulation, simulation_mismatch
 
 #: How a user lets another repertoire fingerprint or sensor layout through.
@@ -203,6 +203,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
             starts = starts[np.argsort(starts[:, 0], kind="stable")]
         else:
             starts = task.nominal_starts()
+        task.progress = EpisodeProgress("replay")  # many PyBullet episodes take minutes
         outcomes, result = replay(arb, task, starts, repertoire)
     finally:
         task.close()

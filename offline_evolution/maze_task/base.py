@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import abc
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -193,6 +194,11 @@ class MazeTaskBase(abc.ABC):
         self.dt = dt
         self.n_cycles = control_steps(settings.episode_time, dt)
         self.footprint_radius = footprint_radius
+        #: Called as ``progress(done, total)`` while a batch of episodes runs, from
+        #: ``(0, total)`` to ``(total, total)``, by tasks whose batches take minutes (the
+        #: legged robots' PyBullet episodes); None: no reports. The 4WS kernel runs a
+        #: batch in one call of seconds and does not report.
+        self.progress: Callable[[int, int], None] | None = None
 
     @property
     def n_mazes(self) -> int:

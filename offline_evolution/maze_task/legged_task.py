@@ -154,8 +154,19 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
         if self.in_process() or len(jobs) == 1:
             if self._local is None:
                 self._local = EpisodeRunner(self.world)
-            return [_run(self._local, job) for job in jobs]
-        return list(self._pool(_init_worker, (self.world,)).map(_episode, jobs))
+            results = (_run(self._local, job) for job in jobs)
+        else:
+            results = self._pool(_init_worker, (self.world,)).map(_episode, jobs)
+        if self.progress is None:
+            return list(results)
+        # The executor yields results in job order as they finish, so counting them as
+        # they come reports the batch's progress without changing what it returns.
+        out = []
+        self.progress(0, len(jobs))
+        for result in results:
+            out.append(result)
+            self.progress(len(out), len(jobs))
+        return out
 
 
 def _padded_traces(results: list[dict], n_cycles: int):
