@@ -411,7 +411,13 @@ def test_hexapod_generated_maze_training_resumes_exactly(tmp_path):
             s, repertoire, checkpoint=ckpt, checkpoint_every=100, workers=2,
             should_stop=lambda: polls.append(1) or len(polls) == 1,
         )  # fmt: skip
-    resumed = evolve(s, repertoire, checkpoint=ckpt, workers=2)
+    reports = []  # the post-evaluation's progress (docs/design.md section 15)
+    resumed = evolve(
+        s, repertoire, checkpoint=ckpt, workers=2,
+        post_progress=lambda done, total: reports.append((done, total)),
+    )  # fmt: skip
     assert histories(resumed) == histories(straight)
     assert resumed.best_network == straight.best_network
     assert resumed.selected_network == straight.selected_network
+    total = resumed.post_evaluation.candidates * resumed.post_evaluation.episodes
+    assert reports == [(done, total) for done in range(total + 1)]

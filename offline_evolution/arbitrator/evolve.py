@@ -375,8 +375,8 @@ class Evolution:
         candidates = self.hall.candidates()
         starts = post_evaluation_starts(self.task, self.settings.seed, self.settings.post_samples)
         reports = progress is not None and hasattr(self.task, "progress")
-        if reports:
-            self.task.progress = progress
+        if reports:  # a task the caller gave keeps its own reporter afterwards
+            before, self.task.progress = self.task.progress, progress
         try:
             post = post_evaluate(
                 self.task,
@@ -389,7 +389,7 @@ class Evolution:
             )
         finally:
             if reports:
-                self.task.progress = None
+                self.task.progress = before
         chosen = candidates[post.index]
         return EvolutionResult(
             settings=self.settings,
