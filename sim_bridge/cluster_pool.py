@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 import socket
 import uuid
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 
 #: The environment variable that names the cluster for a run's evaluations.
 CLUSTER_VARIABLE = "EVORBC_CLUSTER"
@@ -125,13 +125,18 @@ class ClusterExecutor:
         self._init = ray.put((initializer, initargs))  # sent to the cluster once
         self._task = ray.remote(num_cpus=1, max_retries=self.RETRIES)(_run_on_cluster)
 
-    def map(self, fn: Callable, items: Iterable) -> list:
-        """``[fn(item) for item in items]``, computed on the cluster, in order."""
+    def map(self, fn: Callable, items: Iterable) -> Iterator:
+        """``fn(item)`` for every item, computed on the cluster, yielded in order.
+
+        As ``ProcessPoolExecutor.map``: each result comes as soon as it and every one
+        before it have arrived, so a caller can count progress (a generator: the work is
+        sent out on the first ``next``).
+        """
         items = list(items)
         chunks = [items[i : i + self.chunk] for i in range(0, len(items), self.chunk)]
-        results: list = [None] * len(chunks)
+        results: dict = {}  # chunk index -> its values, until yielded
         pending: dict = {}
-        k = 0
+        k = done = 0
         # At most ``workers`` tasks in flight: a cap the user chose with --workers holds.
         while k < len(chunks) or pending:
             while k < len(chunks) and len(pending) < self.workers:
@@ -140,7 +145,9 @@ class ClusterExecutor:
             ready, _ = self._ray.wait(list(pending), num_returns=1)
             for ref in ready:
                 results[pending.pop(ref)] = self._ray.get(ref)
-        return [value for part in results for value in part]
+            while done in results:
+                yield from results.pop(done)
+                done += 1
 
     def shutdown(self, wait: bool = True, cancel_futures: bool = False) -> None:
         """Nothing to stop: tasks end with their chunk (the connection stays)."""

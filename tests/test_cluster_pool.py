@@ -78,9 +78,12 @@ def episodes(workers):
     try:
         controller = task.controller("evorbc", tripod_repertoire(), "polar")
         starts = np.array([[0, -3.5, 0.0, 0.0], [0, -3.4, 0.3, 1.0]])
+        reports = []  # on the cluster too, one report per episode (docs/design.md section 15)
+        task.progress = lambda done, total: reports.append((done, total))
         r = task.evaluate(networks(2), controller, starts, record=True)
     finally:
         task.close()
+    assert reports == [(done, 6) for done in range(7)]
     return np.concatenate([r.pose.ravel(), r.fitness, r.choice.ravel()])
 
 

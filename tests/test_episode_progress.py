@@ -49,6 +49,18 @@ def test_a_short_batch_says_nothing_and_a_long_one_reports_at_most_every_interva
     assert counts == sorted(counts) and len(set(counts)) == len(counts)
 
 
+def test_lines_go_to_stderr_so_json_on_stdout_stays_clean(capsys):
+    clock = Clock()
+    report = EpisodeProgress("evaluate", every=10.0, clock=clock)
+    report(0, 2000)
+    clock.now += 20.0
+    report(1990, 2000)
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    # 99.5 % shows as 99 %: 100 % only when every episode is done
+    assert captured.err == "evaluate: 1990/2000 episodes (99 %), 0.3 min, eta 0.0 min\n"
+
+
 def test_the_end_of_a_long_batch_is_always_said():
     clock, out = Clock(), io.StringIO()
     report = EpisodeProgress("post-evaluation", every=10.0, clock=clock, stream=out)
@@ -66,6 +78,25 @@ def hexapod():
     arb = ArbitratorFile.load(paper_arbitrator("hexapod"))
     rep = Repertoire.load(default_repertoire("hexapod"))
     return arb, rep, MazeTaskSettings(("hexapod",), 1.5, 1, "sensors/hexapod.yaml")
+
+
+def test_in_process_batches_report_each_episode_as_it_finishes(hexapod, monkeypatch):
+    from offline_evolution.maze_task import legged_task
+
+    arb, rep, settings = hexapod
+    ran = []
+    run = legged_task._run
+    monkeypatch.setattr(legged_task, "_run", lambda *a: ran.append(1) or run(*a))
+    task = make_task(settings, "hexapod", workers=1)
+    try:
+        controller = task.controller("evorbc", rep, arb.mapping)
+        starts = np.concatenate([task.sample_starts(np.random.default_rng(4)) for _ in range(3)])
+        seen = []  # episodes run when each report came
+        task.progress = lambda done, total: seen.append((done, len(ran)))
+        task.evaluate([arb.network], controller, starts)
+    finally:
+        task.close()
+    assert seen == [(0, 0), (1, 1), (2, 2), (3, 3)]
 
 
 @pytest.mark.parametrize("workers", [1, 2])

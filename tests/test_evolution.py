@@ -346,3 +346,24 @@ def test_an_interrupted_run_resumes_with_another_length(
         evolve(two, small_repertoire, checkpoint=ckpt)
     assert ckpt.read_text() == kept  # refused, nothing lost
     same(straight, evolve(ten, small_repertoire, checkpoint=ckpt))
+
+
+def test_the_post_evaluation_reports_and_leaves_a_given_tasks_reporter(
+    small_neat_file, small_repertoire
+):
+    s = settings(small_neat_file, generations=2, repertoire=small_repertoire)
+    task = MazeTask(MazeTaskSettings(**SMALL_TASK), "4ws-5")
+
+    def mine(done, total):
+        """The caller's own reporter."""
+
+    task.progress = mine
+    reports = []
+    result = evolve(
+        s, small_repertoire, task=task,
+        post_progress=lambda done, total: reports.append((done, total)),
+    )  # fmt: skip
+    assert task.progress is mine
+    assert result.post_evaluation.candidates > 0
+    # the 4WS kernel runs the post-evaluation in one call and does not report
+    assert reports == []

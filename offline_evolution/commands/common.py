@@ -149,7 +149,7 @@ class EpisodeProgress:
         self.last = now
         tail = "done" if finished else f"eta {elapsed / done * (total - done) / 60:.1f} min"
         print(
-            f"{self.label}: {done}/{total} episodes ({100 * done / total:.0f} %), "
+            f"{self.label}: {done}/{total} episodes ({100 * done // total} %), "
             f"{elapsed / 60:.1f} min, {tail}",
             file=self.stream or sys.stderr,
         )

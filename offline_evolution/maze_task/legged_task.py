@@ -151,6 +151,8 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
         return k if k < len(self.task_mazes) else self.mazes[k]
 
     def _map(self, jobs: list) -> list[dict]:
+        if self.progress is not None:
+            self.progress(0, len(jobs))  # before any work, so the batch is timed from here
         if self.in_process() or len(jobs) == 1:
             if self._local is None:
                 self._local = EpisodeRunner(self.world)
@@ -159,10 +161,9 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
             results = self._pool(_init_worker, (self.world,)).map(_episode, jobs)
         if self.progress is None:
             return list(results)
-        # The executor yields results in job order as they finish, so counting them as
+        # The executors yield results in job order as they finish, so counting them as
         # they come reports the batch's progress without changing what it returns.
         out = []
-        self.progress(0, len(jobs))
         for result in results:
             out.append(result)
             self.progress(len(out), len(jobs))
