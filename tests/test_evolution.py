@@ -230,6 +230,32 @@ def test_a_run_resumes_with_its_sensor_file_moved_but_not_with_another_layout(
     )
 
 
+def test_a_run_resumes_with_a_maze_file_moved_or_renamed_but_not_with_other_walls(
+    tmp_path, small_neat_file, small_repertoire
+):
+    # A training maze kept beside a run and then moved into config/mazes to ship its
+    # controller under another name is the same maze: the run resumes; moved walls are
+    # another run. The task names the shipped `gaps` by name, the copy by its path.
+    s = settings(small_neat_file, generations=4, repertoire=small_repertoire)
+    moved = tmp_path / "my-gaps.yaml"
+    maze = yaml.safe_load((config_dir() / "mazes" / "gaps.yaml").read_text())
+    moved.write_text(yaml.safe_dump({**maze, "name": "my-gaps", "description": "a copy"}))
+
+    def shift_a_wall():
+        maze["walls"][0][0] += 0.05
+        moved.write_text(yaml.safe_dump({**maze, "name": "my-gaps"}))
+
+    task = {**SMALL_TASK, "mazes": ["obstacle", str(moved)]}
+    resumes_moved_but_not_edited(
+        tmp_path,
+        s,
+        small_repertoire,
+        lambda: EvolutionSettings(**{**s.as_dict(), "task": task}),
+        shift_a_wall,
+        r"task\.mazes",
+    )
+
+
 class _ScoredTask:
     """Stands in for MazeTask.evaluate with fixed per-episode outcomes (rule logic only)."""
 

@@ -52,8 +52,9 @@ def nominal_path(name: str) -> float:
     return field.distance_from(*maze.start_pose[:2])
 
 
-def test_the_five_4ws_mazes_the_hexapod_maze_and_the_a1_maze_are_shipped():
-    assert maze_names() == sorted([*NAMES, "hexapod", "a1"])
+def test_the_five_4ws_mazes_the_hexapod_mazes_and_the_a1_maze_are_shipped():
+    # hexapod-anywhere: the hexapod maze with starts anywhere, for training (its own file)
+    assert maze_names() == sorted([*NAMES, "hexapod", "hexapod-anywhere", "a1"])
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -61,6 +61,7 @@ from offline_evolution.checkpoint import (
 )
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
 from offline_evolution.task_protocol import ArbitratorTask
+from sim_bridge.maze import load_named_maze
 from sim_bridge.robots.design import check_simulation
 
 CHECKPOINT_KIND = "evorbc-neat-checkpoint"
@@ -181,22 +182,43 @@ def _without_selection(settings: dict) -> dict:
     return {**settings, "task": {**task, "training": kept}}
 
 
-def _sensors_by_content(settings: dict) -> dict:
-    """``settings`` with the task's sensor file replaced by its layout's fingerprint (a copy).
+def _inputs_by_content(settings: dict) -> dict:
+    """``settings`` with the task's sensor and maze files replaced by what they hold (a copy).
 
-    A sensor file's location, like the NEAT file's, never changes what a run does: a run
-    whose layout file moved (into ``config/sensors`` to ship it, say) resumes from its
-    checkpoint if the layout it holds is the same. A file that does not load keeps its path,
-    so the comparison then names the path.
+    A file's location, like the NEAT file's, never changes what a run does: a run whose
+    sensor layout or training maze moved (into ``config/`` to ship its controller, say)
+    resumes from its checkpoint if the layout and the mazes are the same. The sensor file
+    becomes its layout's fingerprint; each maze entry (a shipped maze's name or a file's
+    path) the fingerprint of its walls, start and target, whatever it is called. A file
+    that does not load keeps its path, so the comparison then names the path.
     """
     task = settings.get("task")
-    if not isinstance(task, dict) or not isinstance(task.get("sensors"), str):
+    if not isinstance(task, dict):
         return settings
+    task = dict(task)
+    if isinstance(task.get("sensors"), str):
+        try:
+            layout = SensorLayout.load(config_dir() / task["sensors"])
+            task["sensors"] = f"layout {layout.fingerprint()}"
+        except (ConfigError, OSError):
+            pass
+    if isinstance(task.get("mazes"), list):
+        task["mazes"] = [_maze_by_content(m) for m in task["mazes"]]
+    return {**settings, "task": task}
+
+
+def _maze_by_content(entry):
+    """A task's maze entry as ``maze <fingerprint>``, or as it is if it does not load."""
+    if not isinstance(entry, str):
+        return entry
     try:
-        layout = SensorLayout.load(config_dir() / task["sensors"])
-    except (ConfigError, OSError):
-        return settings
-    return {**settings, "task": {**task, "sensors": f"layout {layout.fingerprint()}"}}
+        maze = load_named_maze(entry).to_dict()
+    except (ConfigError, OSError, ValueError):
+        return entry
+    # The name and description say what a maze is called, not what a robot meets in it.
+    held = {k: v for k, v in maze.items() if k not in ("name", "description")}
+    digest = hashlib.sha256(json.dumps(held, sort_keys=True).encode()).hexdigest()
+    return f"maze {digest[:16]}"
 
 
 def file_sha256(path: str | os.PathLike, what: str = "NEAT settings") -> str:
@@ -438,9 +460,7 @@ class Evolution:
         # changes its contents, so both may change between sessions.
         ignored = SELECTION_ONLY + LOCATION_ONLY + LENGTH_ONLY
         saved, now = (
-            _sensors_by_content(
-                _without_selection({k: v for k, v in d.items() if k not in ignored})
-            )
+            _inputs_by_content(_without_selection({k: v for k, v in d.items() if k not in ignored}))
             for d in (data["settings"], self.settings.as_dict())
         )
         mismatch = settings_mismatch(saved, now)
