@@ -39,10 +39,13 @@ class CheckpointError(ValueError):
 class Interrupted(Exception):
     """A run was asked to stop; finished work is in the checkpoint."""
 
-    def __init__(self, iteration: int, checkpoint: str | None) -> None:
+    def __init__(self, iteration: int, checkpoint: str | None, during: str | None = None) -> None:
         super().__init__(f"stopped after iteration {iteration}")
         self.iteration = iteration
         self.checkpoint = checkpoint
+        # What was running past the last iteration when the run stopped (a NEAT run's
+        # post-evaluation), or None between iterations.
+        self.during = during
 
 
 def save_checkpoint(path: str | os.PathLike, header: dict, arrays: dict[str, np.ndarray]):

@@ -38,6 +38,28 @@ SMALL_TASK = {
 }
 
 
+def evolution_settings(neat_file, repertoire, task, seed=3, generations=4, **changes):
+    """EvolutionSettings of a small 4ws-5 EvoRBC run (hall of fame 3, 1 post-sample)."""
+    from offline_evolution.arbitrator.evolve import EvolutionSettings, file_sha256
+
+    return EvolutionSettings(
+        **{
+            "kind": "evorbc",
+            "robot": "4ws-5",
+            "generations": generations,
+            "seed": seed,
+            "neat_file": str(neat_file),
+            "neat_sha256": file_sha256(neat_file),
+            "task": task,
+            "mapping": "polar",
+            "repertoire_fingerprint": repertoire.fingerprint(),
+            "hall_of_fame": 3,
+            "post_samples": 1,
+            **changes,
+        }
+    )
+
+
 @pytest.fixture
 def small_neat_file(tmp_path):
     """The shipped NEAT settings with a population of 24 (fast tests)."""

@@ -8,7 +8,7 @@ every generation without compiling again.
 import numpy as np
 import pytest
 import yaml
-from conftest import SMALL_TASK
+from conftest import SMALL_TASK, evolution_settings
 
 from evorbc_ros.config import ConfigError
 from offline_evolution.arbitrator.evolve import EvolutionSettings, evolve, file_sha256
@@ -27,20 +27,7 @@ def task_dict(**training):
     return {**SMALL_TASK, "training": {**TRAINING, **training}}
 
 
-def run_settings(neat_file, repertoire, task, seed=3, generations=4):
-    return EvolutionSettings(
-        kind="evorbc",
-        robot="4ws-5",
-        generations=generations,
-        seed=seed,
-        neat_file=str(neat_file),
-        neat_sha256=file_sha256(neat_file),
-        task=task,
-        mapping="polar",
-        repertoire_fingerprint=repertoire.fingerprint(),
-        hall_of_fame=3,
-        post_samples=1,
-    )
+run_settings = evolution_settings
 
 
 def training_task(**training) -> MazeTask:
@@ -200,8 +187,11 @@ def test_every_genome_of_a_generation_runs_the_same_draw(small_neat_file, small_
     s = run_settings(small_neat_file, small_repertoire, task_dict(), generations=3)
     task = Spy(MazeTaskSettings(**s.task), "4ws-5")
     evolve(s, small_repertoire, task=task)
-    # One call per generation with the whole population, then the post-selection's.
-    assert len(calls) == 4 and [n for n, _, _ in calls[:3]] == [24, 24, 24]
+    # One call per generation with the whole population, then the post-selection's
+    # batches (post_scores.py), each on the same starts in the same mazes.
+    assert [n for n, _, _ in calls[:3]] == [24, 24, 24] and len(calls) > 3
+    post = calls[3:]
+    assert all(np.array_equal(c[1], post[0][1]) and c[2] == post[0][2] for c in post)
     for g, (_, starts, names) in enumerate(calls[:3]):
         expected = training_task()
         rows, _ = expected.generation_episodes(np.random.default_rng([3, g]))

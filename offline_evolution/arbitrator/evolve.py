@@ -45,10 +45,11 @@ from offline_evolution.arbitrator.neat_state import (
     population_to_dict,
     require,
 )
+from offline_evolution.arbitrator.post_scores import PostScores, score_candidates, scores_key
 from offline_evolution.arbitrator.selection import (
     HallOfFame,
     PostEvaluation,
-    post_evaluate,
+    choose,
     post_evaluation_starts,
     validation_rows,
 )
@@ -290,6 +291,7 @@ class Evolution:
         self.best_reached = 0  # mazes the best genome reached in its evaluation
         self.hall = HallOfFame(settings.hall_of_fame)
         self._watched: set[int] = set()  # genome keys already run from the nominal starts
+        self.post_scores: PostScores | None = None  # the post-evaluation's rows so far
 
     def close(self) -> None:
         """Close the task if this run made it (a task given to it is the caller's)."""
@@ -387,31 +389,41 @@ class Evolution:
         return network_spec(genome_from_dict(genome, self.config), self.config)
 
     def result(
-        self, seconds: float, progress: Callable[[int, int], None] | None = None
+        self,
+        seconds: float,
+        progress: Callable[[int, int], None] | None = None,
+        after_batch: Callable[[int, int], None] | None = None,
     ) -> EvolutionResult:
         """Post-evaluate the hall of fame and assemble the run's outcome.
 
         ``progress``: reports the post-evaluation's episodes as they finish, on a task
         that reports (``MazeTaskBase.progress``: the legged robots'); ignored otherwise.
+        ``after_batch``: called as ``(candidates done, candidates)`` after each batch of
+        the post-evaluation (:mod:`~offline_evolution.arbitrator.post_scores`), when
+        :meth:`save` would keep it.
         """
         candidates = self.hall.candidates()
         starts = post_evaluation_starts(self.task, self.settings.seed, self.settings.post_samples)
-        reports = progress is not None and hasattr(self.task, "progress")
-        if reports:  # a task the caller gave keeps its own reporter afterwards
-            before, self.task.progress = self.task.progress, progress
-        try:
-            post = post_evaluate(
-                self.task,
-                self.controller,
-                [self.network(g) for g in candidates],
-                starts,
-                self.settings.post_rule,
-                len(self.task.nominal_starts()),
-                validation_rows(self.task, self.settings.post_samples),
-            )
-        finally:
-            if reports:
-                self.task.progress = before
+        key = scores_key(candidates, starts)
+        if self.post_scores is None or self.post_scores.key != key:
+            # none yet, or saved for another hall or other starts (post_samples changed)
+            self.post_scores = PostScores(key)
+        fitness, reached = score_candidates(
+            self.task,
+            self.controller,
+            [self.network(g) for g in candidates],
+            starts,
+            self.post_scores,
+            after_batch,
+            progress,
+        )
+        post = choose(
+            fitness,
+            reached,
+            self.settings.post_rule,
+            len(self.task.nominal_starts()),
+            validation_rows(self.task, self.settings.post_samples),
+        )
         chosen = candidates[post.index]
         return EvolutionResult(
             settings=self.settings,
@@ -442,6 +454,8 @@ class Evolution:
             "elapsed": elapsed,
             "simulation": self.simulation,
         }
+        if self.post_scores is not None:  # the finished run's post-evaluation so far
+            data["post_scores"] = self.post_scores.to_dict()
         atomic_write_text(path, json.dumps(data))
 
     def restore(self, path: str | os.PathLike) -> float:
@@ -513,6 +527,8 @@ class Evolution:
             for key, kind in kinds.items():
                 require(h, key, kind, f"history[{i}].")
         self.history = [GenerationStats(**{k: h[k] for k in kinds}) for h in history]
+        if "post_scores" in data:  # interrupted in its post-evaluation
+            self.post_scores = PostScores.from_dict(require(data, "post_scores", dict))
         return float(require(data, "elapsed", float))
 
 
@@ -579,15 +595,29 @@ def evolve(
                 run.save(checkpoint, time.perf_counter() - start)
                 saved = run.generation
             if stop:
-                raise Interrupted(run.generation, None if checkpoint is None else str(checkpoint))
-        if checkpoint is not None and keep_checkpoint and saved != run.generation:
+                raise Interrupted(run.generation, _path(checkpoint))
+        # The finished population is saved before the post-evaluation, and every batch of
+        # it after, so an interruption there loses at most a batch (post_scores.py).
+        if checkpoint is not None and saved != run.generation:
             run.save(checkpoint, time.perf_counter() - start)
-        result = run.result(time.perf_counter() - start, post_progress)
+
+        def after_batch(done: int, total: int) -> None:
+            if checkpoint is not None:
+                run.save(checkpoint, time.perf_counter() - start)
+            if should_stop is not None and done < total and should_stop():
+                during = f"the post-evaluation ({done} of {total} candidates done)"
+                raise Interrupted(run.generation, _path(checkpoint), during)
+
+        result = run.result(time.perf_counter() - start, post_progress, after_batch)
         if checkpoint is not None and not keep_checkpoint and os.path.exists(checkpoint):
             os.remove(checkpoint)
         return result
     finally:
         run.close()
+
+
+def _path(checkpoint: str | os.PathLike | None) -> str | None:
+    return None if checkpoint is None else str(checkpoint)
 
 
 def arbitrator_file(

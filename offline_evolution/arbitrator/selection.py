@@ -192,34 +192,56 @@ def post_evaluate(
     nominal_rows: int | None = None,
     validation: int = 0,
 ) -> PostEvaluation:
-    """Score every network on ``starts`` and pick one by ``rule`` (see :data:`RULES`).
+    """Score every network on ``starts`` in one batch and pick one by ``rule`` (:func:`choose`).
 
-    ``starts`` begins with the task's ``nominal_rows`` nominal starts (by default one per
-    maze of a maze task) and ends with ``validation`` rows in generated validation mazes,
-    as :func:`post_evaluation_starts` lays them out. Ties go to the earlier candidate (the
-    hall lists the highest training fitness first). The reported ``fitness`` is the mean
-    over every episode whatever the rule.
+    ``nominal_rows`` defaults to one per maze of a maze task.
     """
     if rule not in RULES:
         raise ValueError(f"post-evaluation rule must be one of {', '.join(RULES)}, got {rule!r}")
     result = task.evaluate(networks, controller, starts)
     n = len(starts)
-    fitness = result.fitness.reshape(len(networks), n).mean(axis=1)
-    reached_all = result.reached.reshape(len(networks), n).astype(bool)
+    return choose(
+        result.fitness.reshape(len(networks), n),
+        result.reached.reshape(len(networks), n),
+        rule,
+        len(task.mazes) if nominal_rows is None else nominal_rows,
+        validation,
+    )
+
+
+def choose(
+    fitness_all: np.ndarray,
+    reached_all: np.ndarray,
+    rule: str = "mean",
+    nominal_rows: int = 1,
+    validation: int = 0,
+) -> PostEvaluation:
+    """Pick a candidate by ``rule`` (see :data:`RULES`) from its post-evaluation episodes.
+
+    ``fitness_all`` (eq. 5) and ``reached_all`` are (candidates, episodes), one row per
+    candidate in hall order, one column per start of :func:`post_evaluation_starts`: the
+    task's ``nominal_rows`` nominal starts first, ``validation`` columns in generated
+    validation mazes last. Ties go to the earlier candidate (the hall lists the highest
+    training fitness first). The reported ``fitness`` is the mean over every episode
+    whatever the rule.
+    """
+    if rule not in RULES:
+        raise ValueError(f"post-evaluation rule must be one of {', '.join(RULES)}, got {rule!r}")
+    candidates, n = fitness_all.shape
+    fitness = fitness_all.mean(axis=1)
+    reached_all = reached_all.astype(bool)
     reached = reached_all.mean(axis=1)
-    if nominal_rows is None:
-        nominal_rows = len(task.mazes)
     nominal = reached_all[:, :nominal_rows].all(axis=1)
     base = rule.removeprefix("nominal_then_")
     eligible = nominal if base != rule and nominal.any() else np.ones_like(nominal)
     score = fitness
     if base in ("balanced", "reach") and 0 < validation < n:
-        score = _two_suite_mean(result.fitness.reshape(len(networks), n), validation)
+        score = _two_suite_mean(fitness_all, validation)
     if base == "reach":
         rate = _two_suite_mean(reached_all, validation) if 0 < validation < n else reached
         # Eligible first, then the highest reach rate, then the better fitness score; ties
         # go to the earlier candidate.
-        order = np.lexsort((np.arange(len(networks)), -score, -rate, ~eligible))
+        order = np.lexsort((np.arange(candidates), -score, -rate, ~eligible))
         k = int(order[0])
     else:
         k = int(np.argmax(np.where(eligible, score, -np.inf)))
@@ -227,7 +249,7 @@ def post_evaluate(
         k,
         float(fitness[k]),
         float(reached[k]),
-        len(networks),
+        candidates,
         n,
         fitness,
         rule,

@@ -98,8 +98,9 @@ def running(step: str, unit: str) -> Iterator[StopOnSignal]:
             raise CliError(f"{e}; use --restart to discard it") from None
         raise CliError(f"{e}; choose another --checkpoint") from None
     except Interrupted as e:
+        where = f"during {e.during}" if e.during else f"after {unit} {e.iteration}"
         raise CliError(
-            f"interrupted after {unit} {e.iteration}; finished work is saved in "
+            f"interrupted {where}; finished work is saved in "
             f"{e.checkpoint}; run the same command again to resume",
             EXIT_INTERRUPTED,
         ) from None
