@@ -10,6 +10,7 @@ wall-following paths.
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 import pytest
@@ -257,3 +258,16 @@ def test_plot_mazes_writes_a_png(tmp_path):
     plot_mazes([load_named_maze("obstacle"), load_named_maze("gaps")], path)
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert [p.name for p in tmp_path.iterdir()] == ["mazes.png"]  # no temp file left
+
+
+def test_hexapod_anywhere_is_the_hexapod_maze_with_starts_anywhere():
+    # The generalising hexapod controller trains on both (config/tasks/
+    # maze-hexapod-anywhere.yaml) and is measured on hexapod.yaml's starts alone.
+    maze, anywhere = load_named_maze("hexapod"), load_named_maze("hexapod-anywhere")
+    np.testing.assert_array_equal(anywhere.walls, maze.walls)
+    assert anywhere.target == maze.target and anywhere.target_radius == maze.target_radius
+    assert anywhere.start_pose == maze.start_pose
+    assert anywhere.start_heading == pytest.approx((-math.pi, math.pi))
+    lo_x, hi_x, lo_y, hi_y = maze.bounds()
+    assert anywhere.start_x[1] - anywhere.start_x[0] > 0.9 * (hi_x - lo_x)
+    assert anywhere.start_y[1] - anywhere.start_y[0] > 0.85 * (hi_y - lo_y)
