@@ -116,6 +116,8 @@ def score_candidates(
         ``(fitness, reached)``, each (candidates, episodes), float64 and bool.
     """
     n = len(starts)
+    if len(scores.fitness) > len(networks) or any(len(r) != n for r in scores.fitness):
+        scores.fitness.clear(), scores.reached.clear()  # not rows of these starts: run again
     total = (len(networks) - len(scores.fitness)) * n
     reports = progress is not None and hasattr(task, "progress")
     if reports:  # a task the caller gave keeps its own reporter afterwards

@@ -157,7 +157,8 @@ def _run(args, settings, every: int, repertoire, checkpoint: Path):
     if args.restart:
         restart_from_scratch(checkpoint, CHECKPOINT_KIND, "NEAT evolution checkpoint")
     printer = _GenerationPrinter(args.quiet, settings.generations)
-    with running("generation", "generation") as stop:
+    # After the last generation the run stops between batches of its post-evaluation.
+    with running("generation (or post-evaluation batch)", "generation") as stop:
         return evolve(
             settings,
             repertoire,
