@@ -256,6 +256,30 @@ def test_a_run_resumes_with_a_maze_file_moved_or_renamed_but_not_with_other_wall
     )
 
 
+def test_a_maze_file_moved_away_resumes_and_one_edited_in_place_does_not(
+    tmp_path, small_neat_file, small_repertoire
+):
+    # The checkpoint records what the task's mazes held when it was saved, so the old path
+    # need not exist any more, and a file edited where it lies is not the same maze.
+    here, there = tmp_path / "here.yaml", tmp_path / "there.yaml"
+    here.write_text((config_dir() / "mazes" / "gaps.yaml").read_text())
+    s = settings(small_neat_file, generations=4, repertoire=small_repertoire)
+    at = lambda p: EvolutionSettings(**{**s.as_dict(), "task": {**SMALL_TASK, "mazes": [str(p)]}})  # noqa: E731
+    straight = evolve(at(here), small_repertoire)
+    ckpt = tmp_path / "c.json"
+    with pytest.raises(Interrupted):
+        evolve(at(here), small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    here.rename(there)
+    same(straight, evolve(at(there), small_repertoire, checkpoint=ckpt))
+    with pytest.raises(Interrupted):
+        evolve(at(there), small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    maze = yaml.safe_load(there.read_text())
+    maze["target"][0] -= 0.1
+    there.write_text(yaml.safe_dump(maze))
+    with pytest.raises(CheckpointError, match=r"task\.mazes"):
+        evolve(at(there), small_repertoire, checkpoint=ckpt)
+
+
 class _ScoredTask:
     """Stands in for MazeTask.evaluate with fixed per-episode outcomes (rule logic only)."""
 

@@ -15,7 +15,7 @@ from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.arbitrator.evolve import evolve
-from offline_evolution.arbitrator.post_scores import PostScores, score_candidates
+from offline_evolution.arbitrator.post_scores import PostScores, score_candidates, scores_key
 from offline_evolution.checkpoint import CheckpointError, Interrupted
 from offline_evolution.commands.common import CliError, running
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
@@ -150,3 +150,41 @@ def test_legged_batches_equal_one_batch_and_report_as_one(tmp_path):
     assert fitness[0].tolist() != fitness[1].tolist()  # the candidates differ
     assert batches == [(1, 3), (2, 3), (3, 3)]
     assert calls == [(0, 6), (1, 6), (2, 6), (3, 6), (4, 6), (5, 6), (6, 6)]
+
+
+def test_the_key_is_of_the_genomes_their_order_and_the_starts():
+    genomes = [
+        {"key": 1, "nodes": [[0, 0.5]], "fitness": 1.0},
+        {"key": 2, "nodes": [], "fitness": 0.5},
+    ]
+    starts = np.array([[0, -1.0, 0.5, 0.0], [0, 1.0, 0.5, 1.5]])
+    key = scores_key(genomes, starts)
+    assert key == scores_key([dict(g) for g in genomes], starts.copy())
+    other_weight = [{**genomes[0], "nodes": [[0, 0.6]]}, genomes[1]]
+    other_start = starts.copy()
+    other_start[1, 3] = 1.6  # the same shape
+    for changed in (
+        scores_key(other_weight, starts),
+        scores_key(genomes[::-1], starts),
+        scores_key(genomes, other_start),
+        scores_key(genomes, starts.reshape(4, 2)),
+    ):
+        assert changed != key
+
+
+def test_a_run_stopped_in_its_post_evaluation_runs_on_to_more_generations(
+    tmp_path, small_neat_file, small_repertoire
+):
+    # Its saved rows are of the old hall of fame: the longer run scores its own.
+    s = settings(small_neat_file, small_repertoire)
+    ckpt, _ = stopped_in_post_evaluation(tmp_path, s, small_repertoire)
+    longer = dataclasses.replace(s, generations=GENERATIONS + 2)
+    with pytest.raises(Interrupted):  # stops after the first of the two new generations
+        evolve(longer, small_repertoire, checkpoint=ckpt, should_stop=lambda: True)
+    assert "post_scores" not in json.loads(ckpt.read_text())
+    resumed = evolve(longer, small_repertoire, checkpoint=ckpt)
+    straight = evolve(longer, small_repertoire)
+    assert resumed.selected_network == straight.selected_network
+    np.testing.assert_array_equal(
+        resumed.post_evaluation.all_fitness, straight.post_evaluation.all_fitness
+    )

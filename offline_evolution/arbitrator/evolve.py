@@ -367,6 +367,9 @@ class Evolution:
     def step(self) -> GenerationStats:
         """Evaluate the current generation and breed the next one."""
         start = time.perf_counter()
+        # A finished run resumed with more generations: its post-evaluation's rows are of
+        # another hall of fame now, so they are not kept in the next checkpoints.
+        self.post_scores = None
         generation = self.population.generation
         species = len(self.population.species.species)
         self.population.run(self._evaluate, 1)
@@ -454,6 +457,9 @@ class Evolution:
             "elapsed": elapsed,
             "simulation": self.simulation,
         }
+        # The task's sensor layout and mazes as they were, compared on resume with the files
+        # then: a file edited in place is another run; a moved or renamed one is not.
+        data["task_by_content"] = _inputs_by_content(self.settings.as_dict())["task"]
         if self.post_scores is not None:  # the finished run's post-evaluation so far
             data["post_scores"] = self.post_scores.to_dict()
         atomic_write_text(path, json.dumps(data))
@@ -477,6 +483,9 @@ class Evolution:
             _inputs_by_content(_without_selection({k: v for k, v in d.items() if k not in ignored}))
             for d in (data["settings"], self.settings.as_dict())
         )
+        recorded = data.get("task_by_content")  # absent in checkpoints before 2026-11-27
+        if isinstance(recorded, dict):
+            saved = _without_selection({**saved, "task": recorded})
         mismatch = settings_mismatch(saved, now)
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
@@ -555,14 +564,17 @@ def evolve(
         checkpoint: resumed from if it exists, written every ``checkpoint_every``
             generations, removed at the end (unless ``keep_checkpoint``).
         progress: called after every generation.
-        should_stop: polled after every generation; True saves and raises
-            :class:`~offline_evolution.repertoire.map_elites.Interrupted`.
+        should_stop: polled after every generation and after every batch of the
+            post-evaluation; True saves and raises
+            :class:`~offline_evolution.repertoire.map_elites.Interrupted` (a stop asked for
+            in the last generation stops after the post-evaluation's first batch).
         workers: processes that run episodes (PyBullet robots; default: every core). The
             result does not depend on it.
         repertoire_source: how errors name the repertoire (its file).
         keep_checkpoint: save the finished run to ``checkpoint`` and keep it, for a caller
             that removes it only once the arbitrator file is safely written; the same
-            call then only post-evaluates again (seeded: the same result).
+            call then only post-evaluates again, with the rows it saved (seeded: the same
+            result).
         task: the task to evolve on (any :class:`~offline_evolution.task_protocol.
             ArbitratorTask`); by default the maze task ``settings.task`` describes for
             ``settings.robot``. A task given here is left open for the caller.

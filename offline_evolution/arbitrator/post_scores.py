@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -74,12 +75,13 @@ class PostScores:
         rows = {len(r) if isinstance(r, list) else -1 for r in fitness + reached}
         if len(fitness) != len(reached) or len(rows) > 1 or -1 in rows:
             raise ValueError(f"{where}fitness and reached must be rows of equal length")
-        try:
-            values = np.array(fitness, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise ValueError(f"{where}fitness must hold numbers") from None
-        if not np.isfinite(values).all():
-            raise ValueError(f"{where}fitness holds a value that is not finite")
+        # bool is an int subclass: true where a fitness belongs is a damaged file.
+        if not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+            for row in fitness
+            for v in row
+        ):
+            raise ValueError(f"{where}fitness must hold finite numbers")
         if not all(isinstance(v, bool) for row in reached for v in row):
             raise ValueError(f"{where}reached must hold true or false")
         return cls(key, [[float(v) for v in row] for row in fitness], [list(r) for r in reached])
