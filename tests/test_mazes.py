@@ -261,7 +261,7 @@ def test_plot_mazes_writes_a_png(tmp_path):
 
 
 def test_hexapod_anywhere_is_the_hexapod_maze_with_starts_anywhere():
-    # The generalising hexapod controller trains on both (config/tasks/
+    # hexapod-t90-any trains on both (config/tasks/
     # maze-hexapod-anywhere.yaml) and is measured on hexapod.yaml's starts alone.
     maze, anywhere = load_named_maze("hexapod"), load_named_maze("hexapod-anywhere")
     np.testing.assert_array_equal(anywhere.walls, maze.walls)
