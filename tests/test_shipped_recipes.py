@@ -1,10 +1,11 @@
-"""The shipped 4ws-5 controller records the shipped recipe (evorbc_ros/data/README.md).
+"""The shipped generalising controllers record the shipped recipes (evorbc_ros/data/README.md).
 
-`evorbc-evolve arbitrator --config config/arbitrator/4ws-generated.yaml --seed 4` is the
-command that wrote `evorbc_ros/data/4ws-5.arbitrator.json`. If one of the files it reads
-(the run settings, the task, the NEAT settings, the sensor layout) is edited without
-shipping a controller made with it, the command would no longer make the shipped file:
-these checks fail instead of the record going silently stale.
+`evorbc-evolve arbitrator --config config/arbitrator/4ws-generated.yaml --seed 4` wrote
+`evorbc_ros/data/4ws-5.arbitrator.json`. If one of the files such a command reads (the run
+settings, the task, the NEAT settings, the sensor layout) is edited without shipping a
+controller made with it, the command would no longer make the shipped file: these checks
+fail instead of the record going silently stale. A robot whose generalising controller
+ships adds its run settings and seed to :data:`RECIPES`.
 """
 
 import pytest
@@ -18,41 +19,48 @@ from offline_evolution.arbitrator.evolve import file_sha256
 from offline_evolution.arbitrator.settings import load_run_settings
 from offline_evolution.maze_task.task import MazeTaskSettings
 
-SEED = 4  # the --seed of the recorded command
+# robot: (its run settings in config/arbitrator, the --seed of the recorded command)
+RECIPES = {"4ws-5": ("4ws-generated.yaml", 4)}
 
 
-@pytest.fixture(scope="module")
-def shipped():
-    """``(arbitrator file, run settings, task settings)`` of the shipped recipe."""
-    run = load_run_settings(config_dir() / "arbitrator" / "4ws-generated.yaml")
+@pytest.fixture(scope="module", params=sorted(RECIPES))
+def shipped(request):
+    """``(robot, arbitrator file, run settings, task settings)`` of a shipped recipe."""
+    robot = request.param
+    run = load_run_settings(config_dir() / "arbitrator" / RECIPES[robot][0])
     task = MazeTaskSettings.load(run.task_path())
-    return ArbitratorFile.load(default_arbitrator("4ws-5")), run, task
+    return robot, ArbitratorFile.load(default_arbitrator(robot)), run, task
 
 
 def test_the_shipped_controller_records_the_shipped_task_and_neat_settings(shipped):
-    arb, run, task = shipped
+    robot, arb, run, task = shipped
     evolution = arb.evolution
-    assert evolution["seed"] == SEED
+    assert evolution["seed"] == RECIPES[robot][1]
     assert evolution["generations"] == run.generations
     assert evolution["task"] == task.as_dict()
-    assert evolution["task"]["training"]["perturb"] == "realistic"
     assert evolution["neat_sha256"] == file_sha256(run.neat_path())
     assert arb.mapping == run.mapping
 
 
+def test_the_4ws_controller_trained_in_perturbed_worlds():
+    arb = ArbitratorFile.load(default_arbitrator("4ws-5"))
+    assert arb.evolution["task"]["training"]["perturb"] == "realistic"
+
+
 def test_the_shipped_controller_was_chosen_by_the_shipped_post_selection(shipped):
-    arb, run, _ = shipped
+    _, arb, run, _ = shipped
     post = arb.evolution["post_evaluation"]
     assert post["rule"] == run.post_rule
     assert post["hall_of_fame"] == run.hall_of_fame
     assert post["samples_per_maze"] == run.post_samples
     assert post["snapshot_every"] == run.snapshot_every
+    assert post["nominal_watch"] == run.nominal_watch
 
 
 def test_the_shipped_controller_reads_the_shipped_layout_over_the_shipped_repertoire(shipped):
-    arb, _, task = shipped
+    robot, arb, _, task = shipped
     layout = SensorLayout.load(config_dir() / task.sensors)
     assert arb.sensors.fingerprint() == layout.fingerprint()
     assert arb.network.input_keys and len(arb.network.input_keys) == layout.n_inputs
-    repertoire = Repertoire.load(default_repertoire("4ws-5"))
+    repertoire = Repertoire.load(default_repertoire(robot))
     assert arb.repertoire["fingerprint"] == repertoire.fingerprint()
