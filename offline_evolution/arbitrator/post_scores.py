@@ -1,7 +1,7 @@
 """The post-evaluation's episodes in batches, kept in the checkpoint as they finish.
 
 A legged robot's post-selection is a long run of its own: `hexapod-t90-any`'s scored
-65 candidates on 52 starts of up to 90 s, 3,380 PyBullet episodes, about 11 min on two
+65 candidates on 52 starts of up to 90 s, 3,380 PyBullet episodes, about 14 min on two
 cores. Run as one batch, an interruption lost all of it. Here the hall of fame is scored a
 few candidates at a time; after each batch the caller saves the rows so far in the run's
 checkpoint, and a resumed run scores only the candidates left (docs/design.md section 13).
