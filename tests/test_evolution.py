@@ -281,7 +281,8 @@ def test_a_maze_file_moved_away_resumes_and_one_edited_in_place_does_not(
 
 
 class _ScoredTask:
-    """Stands in for MazeTask.evaluate with fixed per-episode outcomes (rule logic only)."""
+    """Stands in for MazeTask.evaluate with fixed per-episode outcomes (rule logic only):
+    the "networks" are row numbers of ``fitness`` and ``reached`` (candidates x starts)."""
 
     def __init__(self, fitness, reached):
         self.mazes = ("a",)
@@ -290,7 +291,10 @@ class _ScoredTask:
     def evaluate(self, networks, controller, starts):
         from types import SimpleNamespace
 
-        return SimpleNamespace(fitness=self.fitness.ravel(), reached=self.reached.ravel())
+        rows = list(networks)  # a batch of the post-evaluation (post_scores.py)
+        return SimpleNamespace(
+            fitness=self.fitness[rows].ravel(), reached=self.reached[rows].ravel()
+        )
 
 
 @pytest.mark.parametrize(

@@ -45,11 +45,11 @@ from offline_evolution.arbitrator.neat_state import (
     population_to_dict,
     require,
 )
-from offline_evolution.arbitrator.post_scores import PostScores, score_candidates, scores_key
+from offline_evolution.arbitrator.post_scores import PostScores, scores_key
 from offline_evolution.arbitrator.selection import (
     HallOfFame,
     PostEvaluation,
-    choose,
+    post_evaluate,
     post_evaluation_starts,
     validation_rows,
 )
@@ -292,6 +292,10 @@ class Evolution:
         self.hall = HallOfFame(settings.hall_of_fame)
         self._watched: set[int] = set()  # genome keys already run from the nominal starts
         self.post_scores: PostScores | None = None  # the post-evaluation's rows so far
+        # The task's sensor layout and mazes as this run read them, saved in checkpoints and
+        # compared on resume with the files then: a file edited in place is another run; a
+        # moved or renamed one is not.
+        self._task_by_content = _inputs_by_content(settings.as_dict())["task"]
 
     def close(self) -> None:
         """Close the task if this run made it (a task given to it is the caller's)."""
@@ -411,21 +415,17 @@ class Evolution:
         if self.post_scores is None or self.post_scores.key != key:
             # none yet, or saved for another hall or other starts (post_samples changed)
             self.post_scores = PostScores(key)
-        fitness, reached = score_candidates(
+        post = post_evaluate(
             self.task,
             self.controller,
             [self.network(g) for g in candidates],
             starts,
-            self.post_scores,
-            after_batch,
-            progress,
-        )
-        post = choose(
-            fitness,
-            reached,
             self.settings.post_rule,
             len(self.task.nominal_starts()),
             validation_rows(self.task, self.settings.post_samples),
+            self.post_scores,
+            after_batch,
+            progress,
         )
         chosen = candidates[post.index]
         return EvolutionResult(
@@ -457,9 +457,7 @@ class Evolution:
             "elapsed": elapsed,
             "simulation": self.simulation,
         }
-        # The task's sensor layout and mazes as they were, compared on resume with the files
-        # then: a file edited in place is another run; a moved or renamed one is not.
-        data["task_by_content"] = _inputs_by_content(self.settings.as_dict())["task"]
+        data["task_by_content"] = self._task_by_content
         if self.post_scores is not None:  # the finished run's post-evaluation so far
             data["post_scores"] = self.post_scores.to_dict()
         atomic_write_text(path, json.dumps(data))
@@ -479,13 +477,15 @@ class Evolution:
         # Selection settings never change the population, and a file's location never
         # changes its contents, so both may change between sessions.
         ignored = SELECTION_ONLY + LOCATION_ONLY + LENGTH_ONLY
-        saved, now = (
-            _inputs_by_content(_without_selection({k: v for k, v in d.items() if k not in ignored}))
-            for d in (data["settings"], self.settings.as_dict())
-        )
+        saved = {k: v for k, v in data["settings"].items() if k not in ignored}
         recorded = data.get("task_by_content")  # absent in checkpoints before 2026-11-27
         if isinstance(recorded, dict):
-            saved = _without_selection({**saved, "task": recorded})
+            saved = {**saved, "task": recorded}
+        else:  # read what the saved paths hold now
+            saved = _inputs_by_content(saved)
+        now = {k: v for k, v in self.settings.as_dict().items() if k not in ignored}
+        saved = _without_selection(saved)
+        now = _without_selection({**now, "task": self._task_by_content})
         mismatch = settings_mismatch(saved, now)
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")

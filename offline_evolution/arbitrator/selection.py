@@ -10,10 +10,13 @@ training fitness, is reported unchanged next to it.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from offline_evolution.arbitrator.post_scores import PostScores, score_candidates
 
 if TYPE_CHECKING:  # a task pulls in its simulation; the settings loader needs only RULES
     from offline_evolution.task_protocol import ArbitratorTask
@@ -191,45 +194,35 @@ def post_evaluate(
     rule: str = "mean",
     nominal_rows: int | None = None,
     validation: int = 0,
+    scores: PostScores | None = None,
+    after_batch: Callable[[int, int], None] | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> PostEvaluation:
-    """Score every network on ``starts`` in one batch and pick one by ``rule`` (:func:`choose`).
+    """Score every network on ``starts`` and pick one by ``rule`` (see :data:`RULES`).
 
-    ``nominal_rows`` defaults to one per maze of a maze task.
+    ``starts`` begins with the task's ``nominal_rows`` nominal starts (by default one per
+    maze of a maze task) and ends with ``validation`` rows in generated validation mazes,
+    as :func:`post_evaluation_starts` lays them out. The networks are scored in batches
+    (:func:`~offline_evolution.arbitrator.post_scores.score_candidates`: ``scores`` holds
+    the rows a resumed run saved, ``after_batch`` and ``progress`` are called as there).
+    Ties go to the earlier candidate (the hall lists the highest training fitness first).
+    The reported ``fitness`` is the mean over every episode whatever the rule.
     """
     if rule not in RULES:
         raise ValueError(f"post-evaluation rule must be one of {', '.join(RULES)}, got {rule!r}")
-    result = task.evaluate(networks, controller, starts)
-    n = len(starts)
-    return choose(
-        result.fitness.reshape(len(networks), n),
-        result.reached.reshape(len(networks), n),
-        rule,
-        len(task.mazes) if nominal_rows is None else nominal_rows,
-        validation,
+    fitness_all, reached_all = score_candidates(
+        task,
+        controller,
+        networks,
+        starts,
+        PostScores("") if scores is None else scores,
+        after_batch,
+        progress,
     )
-
-
-def choose(
-    fitness_all: np.ndarray,
-    reached_all: np.ndarray,
-    rule: str = "mean",
-    nominal_rows: int = 1,
-    validation: int = 0,
-) -> PostEvaluation:
-    """Pick a candidate by ``rule`` (see :data:`RULES`) from its post-evaluation episodes.
-
-    ``fitness_all`` (eq. 5) and ``reached_all`` are (candidates, episodes), one row per
-    candidate in hall order, one column per start of :func:`post_evaluation_starts`: the
-    task's ``nominal_rows`` nominal starts first, ``validation`` columns in generated
-    validation mazes last. Ties go to the earlier candidate (the hall lists the highest
-    training fitness first). The reported ``fitness`` is the mean over every episode
-    whatever the rule.
-    """
-    if rule not in RULES:
-        raise ValueError(f"post-evaluation rule must be one of {', '.join(RULES)}, got {rule!r}")
+    if nominal_rows is None:
+        nominal_rows = len(task.mazes)
     candidates, n = fitness_all.shape
     fitness = fitness_all.mean(axis=1)
-    reached_all = reached_all.astype(bool)
     reached = reached_all.mean(axis=1)
     nominal = reached_all[:, :nominal_rows].all(axis=1)
     base = rule.removeprefix("nominal_then_")
