@@ -65,7 +65,14 @@ def check_memory(need: float, what: str, advice: str) -> None:
 
 
 def check_evolution_memory(
-    task, pop_size: int, robot: str, source: str, post_candidates: int, post_samples: int
+    task,
+    pop_size: int,
+    robot: str,
+    source: str,
+    post_candidates: int,
+    post_samples: int,
+    finalists: int = 0,
+    final_samples: int = 0,
 ) -> None:
     """Refuse an evolution whose generation (or post-evaluation) cannot fit in memory.
 
@@ -76,6 +83,7 @@ def check_evolution_memory(
         post_candidates: genomes the post-evaluation re-runs (at most 3 x hall_of_fame, plus
             the snapshots of `snapshot_every`).
         post_samples: its random starts per maze (plus the nominal one).
+        finalists, final_samples: its second round (``post_finalists``), if any.
     """
     mazes = len(task.mazes)
     per_episode = lookup(robot).episode_bytes
@@ -103,6 +111,16 @@ def check_evolution_memory(
         + (f" + {post_extra} in validation mazes)" if post_extra else ")"),
         "lower post_samples or hall_of_fame",
     )
+    if finalists and final_samples:  # the second round's starts have no nominal rows
+        final_extra = training.post_mazes * final_samples if training is not None else 0
+        final = finalists * (mazes * final_samples + final_extra)
+        check_memory(
+            BASE_BYTES + per_episode * final,
+            f"the post-evaluation's finalists ({final:,} episodes: {finalists} genomes x "
+            f"{mazes} mazes x {final_samples} starts"
+            + (f" + {final_extra} in validation mazes)" if final_extra else ")"),
+            "lower post_final_samples or post_finalists",
+        )
 
 
 def replay_bytes(episodes: int, n_cycles: int, n_outputs: int, robot: str) -> float:

@@ -49,6 +49,7 @@ from offline_evolution.arbitrator.post_scores import PostScores, scores_key
 from offline_evolution.arbitrator.selection import (
     HallOfFame,
     PostEvaluation,
+    final_starts,
     post_evaluate,
     post_evaluation_starts,
     validation_rows,
@@ -70,7 +71,14 @@ CHECKPOINT_KIND = "evorbc-neat-checkpoint"
 
 #: EvolutionSettings fields that only decide which genome is written, never how the
 #: population evolves, so they may change when a run resumes from a checkpoint.
-SELECTION_ONLY = ("post_samples", "post_rule", "nominal_watch", "snapshot_every")
+SELECTION_ONLY = (
+    "post_samples",
+    "post_rule",
+    "nominal_watch",
+    "snapshot_every",
+    "post_finalists",
+    "post_final_samples",
+)
 #: Task keys that only decide which genome is written: the generated validation mazes are
 #: drawn from the post-evaluation's own seed stream, never during evolution.
 TASK_SELECTION_ONLY = ("post_mazes",)
@@ -106,6 +114,11 @@ class EvolutionSettings:
     # The champion of every this-many-th generation joins the hall of fame for good, so the
     # post-evaluation can choose from the whole run (0: none).
     snapshot_every: int = 0
+    # The post-evaluation's this-many best candidates (by post_rule) run post_final_samples
+    # more draws of the task's random starts, and the rule picks among them over both
+    # rounds (0: one round; docs/design.md section 8).
+    post_finalists: int = 0
+    post_final_samples: int = 0
 
     def as_dict(self) -> dict:
         """Plain-data form (checkpoints and arbitrator files)."""
@@ -292,6 +305,7 @@ class Evolution:
         self.hall = HallOfFame(settings.hall_of_fame)
         self._watched: set[int] = set()  # genome keys already run from the nominal starts
         self.post_scores: PostScores | None = None  # the post-evaluation's rows so far
+        self.final_scores: PostScores | None = None  # and its finalists' (post_finalists)
         # The task's sensor layout and mazes as this run read them, saved in checkpoints and
         # compared on resume with the files then: a file edited in place is another run; a
         # moved or renamed one is not.
@@ -373,7 +387,7 @@ class Evolution:
         start = time.perf_counter()
         # A finished run resumed with more generations: its post-evaluation's rows are of
         # another hall of fame now, so they are not kept in the next checkpoints.
-        self.post_scores = None
+        self.post_scores = self.final_scores = None
         generation = self.population.generation
         species = len(self.population.species.species)
         self.population.run(self._evaluate, 1)
@@ -415,6 +429,16 @@ class Evolution:
         if self.post_scores is None or self.post_scores.key != key:
             # none yet, or saved for another hall or other starts (post_samples changed)
             self.post_scores = PostScores(key)
+        s = self.settings
+        more = None
+        if s.post_finalists and s.post_final_samples:
+            if self.final_scores is None:
+                self.final_scores = PostScores("")  # post_evaluate keys it
+
+            def more() -> tuple[np.ndarray, int]:
+                extra = final_starts(self.task, s.seed, s.post_final_samples)
+                return extra, validation_rows(self.task, s.post_final_samples)
+
         post = post_evaluate(
             self.task,
             self.controller,
@@ -426,6 +450,9 @@ class Evolution:
             self.post_scores,
             after_batch,
             progress,
+            s.post_finalists,
+            more,
+            self.final_scores,
         )
         chosen = candidates[post.index]
         return EvolutionResult(
@@ -460,6 +487,8 @@ class Evolution:
         data["task_by_content"] = self._task_by_content
         if self.post_scores is not None:  # the finished run's post-evaluation so far
             data["post_scores"] = self.post_scores.to_dict()
+        if self.final_scores is not None and self.final_scores.key:
+            data["post_final_scores"] = self.final_scores.to_dict()
         atomic_write_text(path, json.dumps(data))
 
     def restore(self, path: str | os.PathLike) -> float:
@@ -538,6 +567,11 @@ class Evolution:
         self.history = [GenerationStats(**{k: h[k] for k in kinds}) for h in history]
         if "post_scores" in data:  # interrupted in its post-evaluation
             self.post_scores = PostScores.from_dict(require(data, "post_scores", dict))
+        if "post_final_scores" in data:  # and in its finalists' round
+            where = "post_final_scores."
+            self.final_scores = PostScores.from_dict(
+                require(data, "post_final_scores", dict), where
+            )
         return float(require(data, "elapsed", float))
 
 
@@ -613,11 +647,11 @@ def evolve(
         if checkpoint is not None and saved != run.generation:
             run.save(checkpoint, time.perf_counter() - start)
 
-        def after_batch(done: int, total: int) -> None:
+        def after_batch(done: int, total: int, what: str = "candidates") -> None:
             if checkpoint is not None:
                 run.save(checkpoint, time.perf_counter() - start)
             if should_stop is not None and done < total and should_stop():
-                during = f"the post-evaluation ({done} of {total} candidates done)"
+                during = f"the post-evaluation ({done} of {total} {what} done)"
                 raise Interrupted(run.generation, _path(checkpoint), during)
 
         result = run.result(time.perf_counter() - start, post_progress, after_batch)
@@ -654,6 +688,11 @@ def arbitrator_file(
             "hall_of_fame": s.hall_of_fame,
             "nominal_watch": s.nominal_watch,
             **({"snapshot_every": s.snapshot_every} if s.snapshot_every else {}),
+            **(
+                {"final_samples_per_maze": s.post_final_samples}
+                if result.post_evaluation.finalists
+                else {}
+            ),
         },
         "seconds": round(result.seconds, 1),
         "neat_settings": Path(s.neat_file).name,

@@ -16,13 +16,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from offline_evolution.arbitrator.post_scores import PostScores, score_candidates
+from offline_evolution.arbitrator.post_scores import PostScores, score_candidates, scores_key
 
 if TYPE_CHECKING:  # a task pulls in its simulation; the settings loader needs only RULES
     from offline_evolution.task_protocol import ArbitratorTask
 
 #: Seed stream of the post-evaluation starts, apart from every generation's.
 POST_EVALUATION_STREAM = 2**31 - 1
+#: Seed stream of the finalists' further starts (``post_finalists``), apart from both.
+FINAL_STREAM = 2**31 - 2
 
 #: How the post-evaluation picks the controller to write:
 #: ``mean``: the highest mean fitness over all post-evaluation episodes;
@@ -138,10 +140,14 @@ class PostEvaluation:
     rule: str = "mean"  # one of RULES
     reached_nominal: bool = False  # the chosen one reached the target from every nominal start
     nominal_reachers: int = 0  # candidates that reached it from every nominal start
+    # With ``post_finalists``: how many candidates ran the further starts, and how many
+    # episodes each ran in all (``fitness`` and ``reached`` are then over those).
+    finalists: int = 0
+    final_episodes: int = 0
 
     def as_dict(self) -> dict:
         """Plain-data form for arbitrator files."""
-        return {
+        out = {
             "fitness": self.fitness,
             "reached": self.reached,
             "candidates": self.candidates,
@@ -150,6 +156,10 @@ class PostEvaluation:
             "reached_nominal": self.reached_nominal,
             "nominal_reachers": self.nominal_reachers,
         }
+        if self.finalists:  # absent otherwise, so that files without finalists read as before
+            out["finalists"] = self.finalists
+            out["episodes_per_finalist"] = self.final_episodes
+        return out
 
 
 def _two_suite_mean(per_episode: np.ndarray, validation: int) -> np.ndarray:
@@ -178,6 +188,21 @@ def post_evaluation_starts(task: ArbitratorTask, seed: int, samples: int) -> np.
     return np.concatenate(rows)
 
 
+def final_starts(task: ArbitratorTask, seed: int, samples: int) -> np.ndarray:
+    """The finalists' further starts: ``samples`` more seeded draws, without nominal rows.
+
+    Laid out as :func:`post_evaluation_starts`' rows after the nominal ones (the task's
+    random starts, then the generated validation mazes' last), from a stream of their own
+    (:data:`FINAL_STREAM`), so none repeats a start of the first round.
+    """
+    rng = np.random.default_rng([seed, FINAL_STREAM])
+    rows = [task.sample_starts(rng) for _ in range(samples)]
+    validation = getattr(task, "validation_starts", None)
+    if validation is not None:
+        rows.append(validation(rng, samples))
+    return np.concatenate(rows)
+
+
 def validation_rows(task: ArbitratorTask, samples: int) -> int:
     """How many of :func:`post_evaluation_starts`' rows lie in generated validation mazes."""
     training = getattr(task, "training", None)
@@ -195,8 +220,11 @@ def post_evaluate(
     nominal_rows: int | None = None,
     validation: int = 0,
     scores: PostScores | None = None,
-    after_batch: Callable[[int, int], None] | None = None,
+    after_batch: Callable[..., None] | None = None,
     progress: Callable[[int, int], None] | None = None,
+    finalists: int = 0,
+    more_starts: Callable[[], tuple[np.ndarray, int]] | None = None,
+    final_scores: PostScores | None = None,
 ) -> PostEvaluation:
     """Score every network on ``starts`` and pick one by ``rule`` (see :data:`RULES`).
 
@@ -207,45 +235,95 @@ def post_evaluate(
     the rows a resumed run saved, ``after_batch`` and ``progress`` are called as there).
     Ties go to the earlier candidate (the hall lists the highest training fitness first).
     The reported ``fitness`` is the mean over every episode whatever the rule.
+
+    With ``finalists`` > 0 and ``more_starts``, a second round: the ``finalists`` best by
+    the rule run further starts, ``more_starts()`` giving ``(starts (E2, 4), validation
+    rows among them)`` (:func:`final_starts`; called only then, since drawing validation
+    starts changes the task's current mazes), and the rule picks among them over both
+    rounds' episodes. One round's winner among many noisy candidates is the luckiest
+    more often than the best (its reach is biased upwards); the second round measures the
+    few that matter on more episodes (docs/design.md section 8). ``final_scores`` holds
+    that round's saved rows (its key is set here), and ``after_batch`` is called with a
+    third argument, ``"finalists"``, during it.
     """
     if rule not in RULES:
         raise ValueError(f"post-evaluation rule must be one of {', '.join(RULES)}, got {rule!r}")
+    scores = PostScores("") if scores is None else scores
     fitness_all, reached_all = score_candidates(
-        task,
-        controller,
-        networks,
-        starts,
-        PostScores("") if scores is None else scores,
-        after_batch,
-        progress,
+        task, controller, networks, starts, scores, after_batch, progress
     )
     if nominal_rows is None:
         nominal_rows = len(task.mazes)
-    candidates, n = fitness_all.shape
-    fitness = fitness_all.mean(axis=1)
-    reached = reached_all.mean(axis=1)
-    nominal = reached_all[:, :nominal_rows].all(axis=1)
-    base = rule.removeprefix("nominal_then_")
-    eligible = nominal if base != rule and nominal.any() else np.ones_like(nominal)
-    score = fitness
-    if base in ("balanced", "reach") and 0 < validation < n:
-        score = _two_suite_mean(fitness_all, validation)
-    if base == "reach":
-        rate = _two_suite_mean(reached_all, validation) if 0 < validation < n else reached
-        # Eligible first, then the highest reach rate, then the better fitness score; ties
-        # go to the earlier candidate.
-        order = np.lexsort((np.arange(candidates), -score, -rate, ~eligible))
-        k = int(order[0])
-    else:
-        k = int(np.argmax(np.where(eligible, score, -np.inf)))
+    all_fitness = fitness_all.mean(axis=1)
+    order, nominal = _ranking(fitness_all, reached_all, rule, nominal_rows, validation)
+    k, rows = int(order[0]), np.arange(len(networks))
+    top = order[: min(finalists, len(networks))]
+    if len(top) and more_starts is not None:
+        extra, extra_validation = more_starts()
+        final_scores = PostScores("") if final_scores is None else final_scores
+        key = final_key(scores.key, top, extra)
+        if final_scores.key != key:  # rows of other finalists or other starts: run again
+            final_scores.key, final_scores.fitness, final_scores.reached = key, [], []
+        stage = None if after_batch is None else lambda d, t: after_batch(d, t, "finalists")
+        f2, r2 = score_candidates(
+            task, controller, [networks[i] for i in top], extra, final_scores, stage, progress
+        )
+        fitness_all = _join(fitness_all[top], f2, validation, extra_validation)
+        reached_all = _join(reached_all[top], r2, validation, extra_validation)
+        validation += extra_validation
+        final_order, _ = _ranking(fitness_all, reached_all, rule, nominal_rows, validation)
+        k, rows = int(top[final_order[0]]), top
+    chosen = int(np.flatnonzero(rows == k)[0])
     return PostEvaluation(
         k,
-        float(fitness[k]),
-        float(reached[k]),
-        candidates,
-        n,
-        fitness,
+        float(fitness_all[chosen].mean()),
+        float(reached_all[chosen].mean()),
+        len(networks),
+        len(starts),
+        all_fitness,
         rule,
         bool(nominal[k]),
         int(nominal.sum()),
+        len(top) if more_starts is not None else 0,
+        fitness_all.shape[1] if more_starts is not None and len(top) else 0,
     )
+
+
+def _ranking(
+    fitness: np.ndarray, reached: np.ndarray, rule: str, nominal_rows: int, validation: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Candidates best first by ``rule``, and which reached from every nominal start.
+
+    ``fitness`` and ``reached`` are (candidates, episodes), the nominal starts' columns
+    first and the ``validation`` columns last. Returns ``(order (candidates,) int,
+    nominal (candidates,) bool)``; ties go to the earlier candidate.
+    """
+    candidates, n = fitness.shape
+    nominal = reached[:, :nominal_rows].all(axis=1)
+    base = rule.removeprefix("nominal_then_")
+    eligible = nominal if base != rule and nominal.any() else np.ones_like(nominal)
+    score = fitness.mean(axis=1)
+    if base in ("balanced", "reach") and 0 < validation < n:
+        score = _two_suite_mean(fitness, validation)
+    keys = [np.arange(candidates), -score]
+    if base == "reach":  # the highest reach rate first, then the better fitness score
+        keys.append(
+            -(_two_suite_mean(reached, validation) if 0 < validation < n else reached.mean(axis=1))
+        )
+    return np.lexsort((*keys, ~eligible)), nominal
+
+
+def _join(first: np.ndarray, second: np.ndarray, validation: int, second_validation: int):
+    """Two rounds' columns of the same candidates, validation columns last: (rows, n1 + n2)."""
+    a, b = first.shape[1] - validation, second.shape[1] - second_validation
+    return np.concatenate([first[:, :a], second[:, :b], first[:, a:], second[:, b:]], axis=1)
+
+
+def final_key(first_key: str, finalists: np.ndarray, starts: np.ndarray) -> str:
+    """What the finalists' rows are of: the first round (its key), who, and the starts.
+
+    The first round's key names its candidates and starts, and its rows decide the
+    finalists; so these with the further starts name the second round's rows.
+    """
+    who = [{"first_round": first_key, "finalists": [int(i) for i in finalists]}]
+    return scores_key(who, starts)

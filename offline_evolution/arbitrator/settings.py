@@ -44,6 +44,16 @@ class ArbitratorRunSettings:
         minimum=0,
     )
 
+    post_finalists: int = setting(
+        0,
+        doc="the post-evaluation's best N candidates (by post_rule) run post_final_samples "
+        "more draws, and the rule picks among them over both rounds (0: one round)",
+        minimum=0,
+    )
+    post_final_samples: int = setting(
+        0, doc="the finalists' further draws of the task's random starts", minimum=0
+    )
+
     def selection(self) -> dict:
         """The keys that choose the genome written (``EvolutionSettings`` fields)."""
         return {
@@ -52,6 +62,8 @@ class ArbitratorRunSettings:
             "post_rule": self.post_rule,
             "nominal_watch": self.nominal_watch,
             "snapshot_every": self.snapshot_every,
+            "post_finalists": self.post_finalists,
+            "post_final_samples": self.post_final_samples,
         }
 
     def neat_path(self) -> Path:

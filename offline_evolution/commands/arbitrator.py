@@ -250,6 +250,8 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         str(args.task or run.task_path()),
         3 * run.hall_of_fame + (generations // run.snapshot_every if run.snapshot_every else 0),
         run.post_samples,
+        run.post_finalists,
+        run.post_final_samples,
     )
     every = args.checkpoint_every or run.checkpoint_every
     with exclusive_outputs({"--out": out, "--checkpoint": args.checkpoint}):
