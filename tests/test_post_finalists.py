@@ -186,3 +186,18 @@ def test_the_second_round_counts_in_the_memory_check(monkeypatch):
     with pytest.raises(ConfigError, match="post_final_samples") as info:
         memory.check_evolution_memory(task, 150, "4ws-5", "t", 75, 10, 10, 10**8)
     assert "the post-evaluation's finalists (2,000,000,000 episodes: 10 genomes" in str(info.value)
+
+
+def test_the_run_settings_carry_the_second_round_and_refuse_a_negative_one(tmp_path):
+    from offline_evolution.arbitrator.settings import load_run_settings
+
+    path = tmp_path / "run.yaml"
+    base = "generations: 1\nneat: neat/4ws.ini\ntask: tasks/maze-4ws.yaml\n"
+    path.write_text(base + "post_finalists: 10\npost_final_samples: 75\n")
+    selection = load_run_settings(path).selection()
+    assert (selection["post_finalists"], selection["post_final_samples"]) == (10, 75)
+    path.write_text(base + "post_finalists: -1\n")
+    with pytest.raises(ConfigError) as info:
+        load_run_settings(path)
+    assert str(info.value).startswith(f"{path}: post_finalists")
+    assert "\n" not in str(info.value)
