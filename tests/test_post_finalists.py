@@ -201,3 +201,25 @@ def test_the_run_settings_carry_the_second_round_and_refuse_a_negative_one(tmp_p
         load_run_settings(path)
     assert str(info.value).startswith(f"{path}: post_finalists")
     assert "\n" not in str(info.value)
+
+
+def test_the_cli_reports_the_chosen_ones_figures_over_both_rounds(
+    tmp_path, capsys, small_repertoire, small_neat_file, small_task_file
+):
+    from offline_evolution.cli import main
+
+    rep, settings_file = tmp_path / "r.json", tmp_path / "run.yaml"
+    small_repertoire.save(rep)
+    settings_file.write_text(
+        "generations: 2\nneat: neat/4ws.ini\ntask: tasks/maze-4ws.yaml\nhall_of_fame: 3\n"
+        "post_samples: 1\npost_finalists: 2\npost_final_samples: 2\n"
+    )
+    argv = ["arbitrator", "--repertoire", rep, "--config", settings_file, "--quiet"]
+    argv += ["--neat-config", small_neat_file, "--task", small_task_file]
+    assert main([str(a) for a in [*argv, "--out", tmp_path / "a.json"]]) == 0
+    out = capsys.readouterr().out
+    arb = ArbitratorFile.load(tmp_path / "a.json")
+    post = arb.evolution["post_evaluation"]
+    # two mazes: 2 x (nominal + 1) in the first round, 2 x 2 in the second
+    assert post["episodes_per_finalist"] == 8 and post["finalists"] == 2
+    assert f"of 8 post-evaluation episodes (one of 2 finalists of {post['candidates']} " in out

@@ -278,11 +278,17 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         write_then_discard(checkpoint, write, discard=not args.keep_checkpoint)
     label = "arbitrator" if args.kind == "evorbc" else "standard-NEAT controller"
     post = result.post_evaluation
+    episodes = f"{post.episodes} post-evaluation episodes"
+    if post.finalists:  # its figures are over both rounds (docs/design.md section 8)
+        episodes = (
+            f"{post.final_episodes} post-evaluation episodes (one of {post.finalists} "
+            f"finalists of {post.candidates} candidates)"
+        )
     print(
         f"{robot} {label}: best fitness {result.best_fitness:.3f} (generation "
         f"{result.best_generation + 1}); the controller written scores {post.fitness:.3f} and "
-        f"reaches the target in {post.reached:.0%} of {post.episodes} post-evaluation "
-        f"episodes; {generations} generations in {result.seconds / 60:.1f} min "
+        f"reaches the target in {post.reached:.0%} of {episodes}; "
+        f"{generations} generations in {result.seconds / 60:.1f} min "
         f"(seed {args.seed}) -> {out}, curve {plot}"
     )
     return 0
