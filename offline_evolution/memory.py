@@ -82,7 +82,8 @@ def check_evolution_memory(
         source: the task settings' file, for the message.
         post_candidates: genomes the post-evaluation re-runs (at most 3 x hall_of_fame, plus
             the snapshots of `snapshot_every`).
-        post_samples: its random starts per maze (plus the nominal one).
+        post_samples: its draws of samples_per_maze random starts per maze (plus the
+            nominal one).
         finalists, final_samples: its second round (``post_finalists``), if any.
     """
     mazes = len(task.mazes)
@@ -94,7 +95,9 @@ def check_evolution_memory(
     extra = training.generated * training.starts if training is not None else 0
     generation = pop_size * (own + extra)
     post_extra = training.post_mazes * post_samples if training is not None else 0
-    post = post_candidates * (mazes * (post_samples + 1) + post_extra)
+    # A draw is samples_per_maze starts in each maze; the first round adds the nominal one.
+    per_maze = post_samples * task.samples_per_maze + 1
+    post = post_candidates * (mazes * per_maze + post_extra)
     where = f"{mazes} mazes x {task.samples_per_maze} starts"
     if training is not None:
         where = f"({where} + {training.generated} generated mazes x {training.starts})"
@@ -107,17 +110,18 @@ def check_evolution_memory(
     check_memory(
         BASE_BYTES + per_episode * post,
         f"the post-evaluation ({post:,} episodes: {post_candidates} genomes x {mazes} mazes "
-        f"x {post_samples + 1} starts"
-        + (f" + {post_extra} in validation mazes)" if post_extra else ")"),
+        f"x {per_maze} starts" + (f" + {post_extra} in validation mazes)" if post_extra else ")"),
         "lower post_samples or hall_of_fame",
     )
     if finalists and final_samples:  # the second round's starts have no nominal rows
         final_extra = training.post_mazes * final_samples if training is not None else 0
-        final = finalists * (mazes * final_samples + final_extra)
+        finalists = min(finalists, post_candidates)
+        final_per_maze = final_samples * task.samples_per_maze
+        final = finalists * (mazes * final_per_maze + final_extra)
         check_memory(
             BASE_BYTES + per_episode * final,
             f"the post-evaluation's finalists ({final:,} episodes: {finalists} genomes x "
-            f"{mazes} mazes x {final_samples} starts"
+            f"{mazes} mazes x {final_per_maze} starts"
             + (f" + {final_extra} in validation mazes)" if final_extra else ")"),
             "lower post_final_samples or post_finalists",
         )

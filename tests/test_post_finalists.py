@@ -79,6 +79,71 @@ def test_the_finalists_round_undoes_a_lucky_first_round(rule):
     assert "finalists" not in one.as_dict()  # files without a second round read as before
 
 
+def test_ties_after_the_second_round_go_to_the_earlier_candidate():
+    # The first round ranks 1 above 0 (4 of 4 against 3 of 4); over both rounds both reach
+    # 17 of 21 with the same fitness: the hall's order decides, as in one round.
+    table = [
+        [1] + [1, 1, 1, 0] + [1] * 14 + [0, 0],
+        [1] + [1, 1, 1, 1] + [1] * 13 + [0, 0, 0],
+    ]
+    for rule in ("mean", "reach"):
+        post = post_evaluate(
+            _Table(table), None, [0, 1], columns(0, 5), rule, 1,
+            finalists=2, more_starts=lambda: (columns(5, 21), 0),
+        )  # fmt: skip
+        assert post.index == 0, rule
+
+
+def _old_choice(fitness, reached, rule, nominal_rows, validation):
+    """The one-round choice as written before the second round (git 1698b40)."""
+    candidates, n = fitness.shape
+    mean, rate = fitness.mean(axis=1), reached.mean(axis=1)
+    nominal = reached[:, :nominal_rows].all(axis=1)
+    base = rule.removeprefix("nominal_then_")
+    eligible = nominal if base != rule and nominal.any() else np.ones_like(nominal)
+    score = mean
+    two = 0 < validation < n
+    if base in ("balanced", "reach") and two:
+        score = 0.5 * (fitness[:, : n - validation].mean(1) + fitness[:, n - validation :].mean(1))
+    if base == "reach":
+        if two:
+            rate = 0.5 * (
+                reached[:, : n - validation].mean(1) + reached[:, n - validation :].mean(1)
+            )
+        return int(np.lexsort((np.arange(candidates), -score, -rate, ~eligible))[0])
+    return int(np.argmax(np.where(eligible, score, -np.inf)))
+
+
+def test_one_round_chooses_as_before_for_every_rule():
+    from offline_evolution.arbitrator.selection import RULES, _ranking
+
+    rng = np.random.default_rng(0)
+    for _ in range(400):
+        candidates, n = rng.integers(1, 7), rng.integers(2, 9)
+        validation = int(rng.integers(0, n))
+        reached = rng.random((candidates, n)) < 0.6
+        # coarse fitness values, so that ties happen
+        fitness = (
+            np.where(reached, rng.integers(3, 5, reached.shape), rng.integers(0, 3, reached.shape))
+            / 2
+        )
+        for rule in RULES:
+            order, _ = _ranking(fitness, reached, rule, 1, validation)
+            assert order[0] == _old_choice(fitness, reached, rule, 1, validation)
+
+
+def test_the_second_rounds_validation_episodes_count_as_validation():
+    # columns: 0 nominal, 1 own, 2 validation (first round); 3 own, 4-5 validation (second)
+    table = [[1, 1, 0, 1, 1, 1], [1, 1, 1, 1, 0, 0]]
+    first = post_evaluate(_Table(table), None, [0, 1], columns(0, 3), "reach", 1, 1)
+    assert first.index == 1  # validation 1 of 1 against 0 of 1
+    two = post_evaluate(
+        _Table(table), None, [0, 1], columns(0, 3), "reach", 1, 1,
+        finalists=2, more_starts=lambda: (columns(3, 6), 2),
+    )  # fmt: skip
+    assert two.index == 0  # own 3 of 3 both; validation 2 of 3 against 1 of 3
+
+
 def test_validation_columns_stay_last_when_the_rounds_are_joined():
     first = np.array([[1, 2, 3, 90]])  # nominal, two own starts, one validation start
     second = np.array([[4, 5, 91, 92]])  # two own starts, two validation starts
@@ -186,6 +251,10 @@ def test_the_second_round_counts_in_the_memory_check(monkeypatch):
     with pytest.raises(ConfigError, match="post_final_samples") as info:
         memory.check_evolution_memory(task, 150, "4ws-5", "t", 75, 10, 10, 10**8)
     assert "the post-evaluation's finalists (2,000,000,000 episodes: 10 genomes" in str(info.value)
+    # More finalists than candidates: only the candidates run.
+    with pytest.raises(ConfigError) as info:
+        memory.check_evolution_memory(task, 150, "4ws-5", "t", 75, 10, 1000, 10**7)
+    assert "(1,500,000,000 episodes: 75 genomes x 2 mazes x 10000000 starts)" in str(info.value)
 
 
 def test_the_run_settings_carry_the_second_round_and_refuse_a_negative_one(tmp_path):
@@ -196,11 +265,13 @@ def test_the_run_settings_carry_the_second_round_and_refuse_a_negative_one(tmp_p
     path.write_text(base + "post_finalists: 10\npost_final_samples: 75\n")
     selection = load_run_settings(path).selection()
     assert (selection["post_finalists"], selection["post_final_samples"]) == (10, 75)
-    path.write_text(base + "post_finalists: -1\n")
-    with pytest.raises(ConfigError) as info:
-        load_run_settings(path)
-    assert str(info.value).startswith(f"{path}: post_finalists")
-    assert "\n" not in str(info.value)
+    for half in ("post_finalists: -1\n", "post_finalists: 10\n", "post_final_samples: 5\n"):
+        path.write_text(base + half)
+        with pytest.raises(ConfigError) as info:
+            load_run_settings(path)
+        assert str(info.value).startswith(f"{path}: post_final")
+        assert "\n" not in str(info.value)
+    assert "go together" in str(info.value)
 
 
 def test_the_cli_reports_the_chosen_ones_figures_over_both_rounds(
@@ -223,3 +294,63 @@ def test_the_cli_reports_the_chosen_ones_figures_over_both_rounds(
     # two mazes: 2 x (nominal + 1) in the first round, 2 x 2 in the second
     assert post["episodes_per_finalist"] == 8 and post["finalists"] == 2
     assert f"of 8 post-evaluation episodes (one of 2 finalists of {post['candidates']} " in out
+
+
+def test_a_damaged_post_final_scores_entry_is_named(tmp_path, small_neat_file, small_repertoire):
+    from offline_evolution.checkpoint import CheckpointError
+
+    s = settings(small_neat_file, small_repertoire)
+    ckpt = tmp_path / "c.json"
+    evolve(s, small_repertoire, checkpoint=ckpt, keep_checkpoint=True)
+    saved = json.loads(ckpt.read_text())
+    saved["post_final_scores"]["fitness"][0][0] = None
+    ckpt.write_text(json.dumps(saved))
+    with pytest.raises(CheckpointError, match=r"post_final_scores\.fitness must hold finite"):
+        evolve(s, small_repertoire, checkpoint=ckpt)
+
+
+def test_another_rule_or_more_finalists_than_candidates(
+    tmp_path, small_neat_file, small_repertoire
+):
+    s = settings(small_neat_file, small_repertoire)
+    ckpt = tmp_path / "c.json"
+    evolve(s, small_repertoire, checkpoint=ckpt, keep_checkpoint=True)
+    # Another rule may pick other finalists: their rows are run, as a straight run would.
+    for changed in (
+        dataclasses.replace(s, post_rule="nominal_then_reach", post_finalists=1),
+        dataclasses.replace(s, post_finalists=50),  # every candidate is a finalist
+    ):
+        kept = evolve(changed, small_repertoire, checkpoint=ckpt, keep_checkpoint=True)
+        same(kept.post_evaluation, evolve(changed, small_repertoire).post_evaluation)
+    assert kept.post_evaluation.finalists == kept.post_evaluation.candidates
+
+
+def test_a_generated_maze_task_keeps_its_validation_columns_apart(
+    tmp_path, small_neat_file, small_repertoire
+):
+    """A training task's second round draws its own validation mazes after the first round
+    has run in its own; interrupted in either round, it resumes to the straight result."""
+    task = {**SMALL_TASK, "training": {"generated": 1, "starts": 1, "pool": 0,
+            "maze_seed": 5, "post_mazes": 2}}  # fmt: skip
+    s = evolution_settings(
+        small_neat_file, small_repertoire, task, seed=5, generations=2,
+        post_finalists=2, post_final_samples=2, post_rule="balanced",
+    )  # fmt: skip
+    straight = evolve(s, small_repertoire)
+    post = straight.post_evaluation
+    # first round: 2 mazes x (nominal + 1) + 2 validation mazes x 1; second: 2 x 2 + 2 x 2
+    assert (post.episodes, post.final_episodes) == (6, 14)
+    # The first round ran in its own validation mazes, as a run without a second round does.
+    one_round = dataclasses.replace(s, post_finalists=0, post_final_samples=0)
+    np.testing.assert_array_equal(
+        post.all_fitness, evolve(one_round, small_repertoire).post_evaluation.all_fitness
+    )
+    for key in ("post_scores", "post_final_scores"):
+        ckpt = tmp_path / f"{key}.json"
+
+        def saved(key=key, ckpt=ckpt) -> bool:
+            return ckpt.exists() and key in json.loads(ckpt.read_text())
+
+        with pytest.raises(Interrupted):
+            evolve(s, small_repertoire, checkpoint=ckpt, should_stop=saved)
+        same(evolve(s, small_repertoire, checkpoint=ckpt).post_evaluation, post)

@@ -413,7 +413,8 @@ class Evolution:
         self,
         seconds: float,
         progress: Callable[[int, int], None] | None = None,
-        after_batch: Callable[[int, int], None] | None = None,
+        after_batch: Callable[..., None] | None = None,
+        final_progress: Callable[[int, int], None] | None = None,
     ) -> EvolutionResult:
         """Post-evaluate the hall of fame and assemble the run's outcome.
 
@@ -421,7 +422,9 @@ class Evolution:
         that reports (``MazeTaskBase.progress``: the legged robots'); ignored otherwise.
         ``after_batch``: called as ``(candidates done, candidates)`` after each batch of
         the post-evaluation (:mod:`~offline_evolution.arbitrator.post_scores`), when
-        :meth:`save` would keep it.
+        :meth:`save` would keep it; in its finalists' round (``post_finalists``) as
+        ``(finalists done, finalists, "finalists")``.
+        ``final_progress``: reports the finalists' round's episodes (default ``progress``).
         """
         candidates = self.hall.candidates()
         starts = post_evaluation_starts(self.task, self.settings.seed, self.settings.post_samples)
@@ -453,6 +456,7 @@ class Evolution:
             s.post_finalists,
             more,
             self.final_scores,
+            final_progress,
         )
         chosen = candidates[post.index]
         return EvolutionResult(
@@ -589,6 +593,7 @@ def evolve(
     task: ArbitratorTask | None = None,
     on_resume: Callable[[int], None] | None = None,
     post_progress: Callable[[int, int], None] | None = None,
+    final_progress: Callable[[int, int], None] | None = None,
 ) -> EvolutionResult:
     """Run NEAT on a task to the last generation (exported as ``evolve_arbitrator``).
 
@@ -617,6 +622,8 @@ def evolve(
             left).
         post_progress: called as ``(done, total)`` while the post-evaluation's episodes
             run, on tasks that report (the legged robots': it can take many minutes).
+        final_progress: the same for its finalists' round (``post_finalists``; default
+            ``post_progress``).
 
     Raises:
         RepertoireError: the repertoire was evolved for another simulated robot.
@@ -654,7 +661,7 @@ def evolve(
                 during = f"the post-evaluation ({done} of {total} {what} done)"
                 raise Interrupted(run.generation, _path(checkpoint), during)
 
-        result = run.result(time.perf_counter() - start, post_progress, after_batch)
+        result = run.result(time.perf_counter() - start, post_progress, after_batch, final_progress)
         if checkpoint is not None and not keep_checkpoint and os.path.exists(checkpoint):
             os.remove(checkpoint)
         return result

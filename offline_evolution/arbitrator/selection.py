@@ -225,6 +225,7 @@ def post_evaluate(
     finalists: int = 0,
     more_starts: Callable[[], tuple[np.ndarray, int]] | None = None,
     final_scores: PostScores | None = None,
+    final_progress: Callable[[int, int], None] | None = None,
 ) -> PostEvaluation:
     """Score every network on ``starts`` and pick one by ``rule`` (see :data:`RULES`).
 
@@ -242,9 +243,11 @@ def post_evaluate(
     starts changes the task's current mazes), and the rule picks among them over both
     rounds' episodes. One round's winner among many noisy candidates is the luckiest
     more often than the best (its reach is biased upwards); the second round measures the
-    few that matter on more episodes (docs/design.md section 8). ``final_scores`` holds
-    that round's saved rows (its key is set here), and ``after_batch`` is called with a
-    third argument, ``"finalists"``, during it.
+    few that matter on more episodes (docs/design.md section 8). The finalists keep their
+    hall order, so ties still go to the earlier candidate. ``final_scores`` holds that
+    round's saved rows (its key is set here), ``final_progress`` reports its episodes (by
+    default ``progress``), and ``after_batch`` is called with a third argument,
+    ``"finalists"``, during it.
     """
     if rule not in RULES:
         raise ValueError(f"post-evaluation rule must be one of {', '.join(RULES)}, got {rule!r}")
@@ -257,7 +260,7 @@ def post_evaluate(
     all_fitness = fitness_all.mean(axis=1)
     order, nominal = _ranking(fitness_all, reached_all, rule, nominal_rows, validation)
     k, rows = int(order[0]), np.arange(len(networks))
-    top = order[: min(finalists, len(networks))]
+    top = np.sort(order[: min(finalists, len(networks))])
     if len(top) and more_starts is not None:
         extra, extra_validation = more_starts()
         final_scores = PostScores("") if final_scores is None else final_scores
@@ -266,7 +269,13 @@ def post_evaluate(
             final_scores.key, final_scores.fitness, final_scores.reached = key, [], []
         stage = None if after_batch is None else lambda d, t: after_batch(d, t, "finalists")
         f2, r2 = score_candidates(
-            task, controller, [networks[i] for i in top], extra, final_scores, stage, progress
+            task,
+            controller,
+            [networks[i] for i in top],
+            extra,
+            final_scores,
+            stage,
+            progress if final_progress is None else final_progress,
         )
         fitness_all = _join(fitness_all[top], f2, validation, extra_validation)
         reached_all = _join(reached_all[top], r2, validation, extra_validation)

@@ -92,6 +92,13 @@ def load_run_settings(
     if path is None:
         path = lookup(robot).settings_file("arbitrator")
     settings = build_settings(ArbitratorRunSettings, load_yaml_mapping(path), str(path))
+    if (settings.post_finalists > 0) != (settings.post_final_samples > 0):
+        # One without the other would run one round and say nothing.
+        raise ConfigError(
+            f"{path}: post_finalists and post_final_samples go together: both above 0 for "
+            f"a second post-selection round, or both 0 (got {settings.post_finalists} and "
+            f"{settings.post_final_samples})"
+        )
     beside = {}
     for key in ("neat", "task"):
         name = getattr(settings, key)

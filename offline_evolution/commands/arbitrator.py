@@ -167,6 +167,7 @@ def _run(args, settings, every: int, repertoire, checkpoint: Path):
             progress=printer,
             on_resume=printer.resumed,
             post_progress=None if args.quiet else EpisodeProgress("post-evaluation"),
+            final_progress=None if args.quiet else EpisodeProgress("post-evaluation, finalists"),
             should_stop=stop,
             workers=args.workers or None,
             repertoire_source=args.repertoire if repertoire else "the repertoire",

@@ -206,7 +206,7 @@ def summarise(
             f"seed {e['seed']} (rule {e['post_evaluation'].get('rule', 'mean')}): "
             f"{e['post_evaluation']['fitness']:.2f}, reached "
             f"{100 * e['post_evaluation']['reached']:.0f} % of "
-            f"{e['post_evaluation']['episodes_per_candidate']}, "
+            f"{_post_episodes(e['post_evaluation'])}, "
             f"{'reaches' if w['reached'] else 'misses'} from the nominal start"
             for e, w in zip(evo, nominal, strict=True)
         )
@@ -387,3 +387,11 @@ def main(robot: str | None = None, name: str = "legged_check") -> None:
 
 if __name__ == "__main__":
     main()
+
+
+def _post_episodes(post: dict) -> int:
+    """Episodes a file's ``post_evaluation`` figures are over.
+
+    A finalist's episodes when it had a second round (docs/design.md section 8).
+    """
+    return post.get("episodes_per_finalist", post["episodes_per_candidate"])
