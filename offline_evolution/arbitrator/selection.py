@@ -181,11 +181,7 @@ def post_evaluation_starts(task: ArbitratorTask, seed: int, samples: int) -> np.
     makes them its current mazes; they are the last :func:`validation_rows` rows.
     """
     rng = np.random.default_rng([seed, POST_EVALUATION_STREAM])
-    rows = [task.nominal_starts()] + [task.sample_starts(rng) for _ in range(samples)]
-    validation = getattr(task, "validation_starts", None)
-    if validation is not None:
-        rows.append(validation(rng, samples))
-    return np.concatenate(rows)
+    return np.concatenate([task.nominal_starts(), _draws(task, rng, samples)])
 
 
 def final_starts(task: ArbitratorTask, seed: int, samples: int) -> np.ndarray:
@@ -195,12 +191,16 @@ def final_starts(task: ArbitratorTask, seed: int, samples: int) -> np.ndarray:
     random starts, then the generated validation mazes' last), from a stream of their own
     (:data:`FINAL_STREAM`), so none repeats a start of the first round.
     """
-    rng = np.random.default_rng([seed, FINAL_STREAM])
+    return _draws(task, np.random.default_rng([seed, FINAL_STREAM]), samples)
+
+
+def _draws(task: ArbitratorTask, rng: np.random.Generator, samples: int) -> np.ndarray:
+    """``samples`` draws of the task's random starts, then its validation mazes' rows."""
     rows = [task.sample_starts(rng) for _ in range(samples)]
     validation = getattr(task, "validation_starts", None)
     if validation is not None:
         rows.append(validation(rng, samples))
-    return np.concatenate(rows)
+    return np.concatenate(rows) if rows else np.zeros((0, 4))
 
 
 def validation_rows(task: ArbitratorTask, samples: int) -> int:
