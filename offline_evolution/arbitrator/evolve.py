@@ -54,6 +54,7 @@ from offline_evolution.arbitrator.selection import (
     post_evaluation_starts,
     validation_rows,
 )
+from offline_evolution.arbitrator.warm_start import network_fingerprint, seed_population
 from offline_evolution.checkpoint import (
     CheckpointError,
     Interrupted,
@@ -84,7 +85,7 @@ SELECTION_ONLY = (
 TASK_SELECTION_ONLY = ("post_mazes",)
 #: Fields that say where an input lies, not what it holds: the NEAT file's contents are
 #: checked by ``neat_sha256``, so a run resumes in another checkout or folder.
-LOCATION_ONLY = ("neat_file",)
+LOCATION_ONLY = ("neat_file", "initial_network_file")
 #: The run's length: nothing before the last generation depends on it (the training draws
 #: are seeded by generation, the hall of fame keeps the best and the latest), so an
 #: interrupted run may resume with more generations, or fewer than planned if it has not
@@ -119,6 +120,10 @@ class EvolutionSettings:
     # rounds (0: one round; docs/design.md section 8).
     post_finalists: int = 0
     post_final_samples: int = 0
+    # The network the first population is made from (warm_start.py, ``--init-from``): its
+    # fingerprint (what a checkpoint compares) and the file it came from (recorded only).
+    initial_network: str | None = None
+    initial_network_file: str | None = None
 
     def as_dict(self) -> dict:
         """Plain-data form (checkpoints and arbitrator files)."""
@@ -254,6 +259,13 @@ class Evolution:
         repertoire_source: how errors name the repertoire (its file).
         task: the task to evolve on; by default the maze task ``settings.task`` describes
             for ``settings.robot``. A task given here stays the caller's to close.
+        initial_network: the network ``settings.initial_network`` fingerprints, for a run
+            that starts from it (:func:`~offline_evolution.arbitrator.warm_start.
+            seed_population`), its inputs numbered for the task's sensor layout.
+
+    Raises:
+        ConfigError: the initial network does not fit the run (or is not the one
+            ``settings`` names).
 
     """
 
@@ -264,6 +276,7 @@ class Evolution:
         workers: int | None = None,
         repertoire_source: str = "the repertoire",
         task: ArbitratorTask | None = None,
+        initial_network: NetworkSpec | None = None,
     ):
         self.settings = settings
         self.owns_task = task is None
@@ -298,6 +311,12 @@ class Evolution:
         self.controller = self.task.controller(settings.kind, repertoire, settings.mapping)
         self.config = load_neat_config(settings.neat_file, self.task.layout.n_inputs, n_outputs)
         self.population = neat.Population(self.config, seed=settings.seed)
+        if settings.initial_network is not None or initial_network is not None:
+            try:
+                self._start_from(initial_network)
+            except ConfigError:
+                self.close()
+                raise
         self.history: list[GenerationStats] = []
         self.best: dict | None = None  # genome_to_dict of the best genome ever
         self.best_generation = -1
@@ -310,6 +329,16 @@ class Evolution:
         # compared on resume with the files then: a file edited in place is another run; a
         # moved or renamed one is not.
         self._task_by_content = _inputs_by_content(settings.as_dict())["task"]
+
+    def _start_from(self, network: NetworkSpec | None) -> None:
+        """Make the first population from ``network`` (the one the settings fingerprint)."""
+        wanted = self.settings.initial_network
+        if network is None or wanted is None or network_fingerprint(network) != wanted:
+            raise ConfigError(
+                "the initial network given is not the one the run settings name "
+                f"({self.settings.initial_network_file or 'none'})"
+            )
+        seed_population(self.population, network)
 
     def close(self) -> None:
         """Close the task if this run made it (a task given to it is the caller's)."""
@@ -511,6 +540,7 @@ class Evolution:
         # changes its contents, so both may change between sessions.
         ignored = SELECTION_ONLY + LOCATION_ONLY + LENGTH_ONLY
         saved = {k: v for k, v in data["settings"].items() if k not in ignored}
+        saved.setdefault("initial_network", None)  # absent before 2026-11-27
         recorded = data.get("task_by_content")  # absent in checkpoints before 2026-11-27
         if isinstance(recorded, dict):
             saved = {**saved, "task": recorded}
@@ -594,6 +624,7 @@ def evolve(
     on_resume: Callable[[int], None] | None = None,
     post_progress: Callable[[int, int], None] | None = None,
     final_progress: Callable[[int, int], None] | None = None,
+    initial_network: NetworkSpec | None = None,
 ) -> EvolutionResult:
     """Run NEAT on a task to the last generation (exported as ``evolve_arbitrator``).
 
@@ -624,12 +655,16 @@ def evolve(
             run, on tasks that report (the legged robots': it can take many minutes).
         final_progress: the same for its finalists' round (``post_finalists``; default
             ``post_progress``).
+        initial_network: the network a run with ``settings.initial_network`` starts from
+            (:mod:`~offline_evolution.arbitrator.warm_start`); a resumed run only checks it
+            against the checkpoint's fingerprint.
 
     Raises:
         RepertoireError: the repertoire was evolved for another simulated robot.
         CheckpointError: the checkpoint exists but belongs to another run or is corrupt.
+        ConfigError: the initial network does not fit the run.
     """
-    run = Evolution(settings, repertoire, workers, repertoire_source, task)
+    run = Evolution(settings, repertoire, workers, repertoire_source, task, initial_network)
     try:
         elapsed = 0.0
         if checkpoint is not None and os.path.exists(checkpoint):
@@ -701,6 +736,16 @@ def arbitrator_file(
                 else {}
             ),
         },
+        **(
+            {
+                "initial_network": {
+                    "file": Path(s.initial_network_file).name if s.initial_network_file else None,
+                    "fingerprint": s.initial_network,
+                }
+            }
+            if s.initial_network
+            else {}
+        ),
         "seconds": round(result.seconds, 1),
         "neat_settings": Path(s.neat_file).name,
         "neat_sha256": s.neat_sha256,

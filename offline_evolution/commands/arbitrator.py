@@ -68,6 +68,13 @@ def _common_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--quiet", action="store_true", help="no per-generation lines (a resume is still said)"
     )
+    p.add_argument(
+        "--init-from",
+        metavar="FILE.json",
+        help="start from this arbitrator file's network (and mutated copies of it) instead "
+        "of random networks: carry a controller on to another task (its inputs are matched "
+        "by name; docs/design.md section 8)",
+    )
     add_workers_option(p)
 
 
@@ -150,7 +157,7 @@ class _GenerationPrinter:
         return f"eta {remaining / 60:5.1f} min"
 
 
-def _run(args, settings, every: int, repertoire, checkpoint: Path):
+def _run(args, settings, every: int, repertoire, checkpoint: Path, initial_network=None):
     """Evolve (resuming from ``checkpoint``); the :class:`EvolutionResult`."""
     from offline_evolution.arbitrator.evolve import CHECKPOINT_KIND, evolve
 
@@ -172,6 +179,7 @@ def _run(args, settings, every: int, repertoire, checkpoint: Path):
             workers=args.workers or None,
             repertoire_source=args.repertoire if repertoire else "the repertoire",
             keep_checkpoint=True,  # deleted only once the files are written
+            initial_network=initial_network,
         )
 
 
@@ -186,6 +194,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     )
     from offline_evolution.arbitrator.neat_config import load_neat_config
     from offline_evolution.arbitrator.settings import load_run_settings
+    from offline_evolution.arbitrator.warm_start import load_initial_network, network_fingerprint
     from offline_evolution.maze_task.task import MazeTaskSettings, make_task
     from offline_evolution.maze_task.training import check_training
     from offline_evolution.memory import check_evolution_memory
@@ -217,6 +226,12 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         misfit = maze.start_misfit(lookup(robot).footprint_radius, robot)
         if misfit:
             raise CliError(f"{args.task or run.task_path()}: mazes: {misfit}")
+    # The NEAT settings and the task's sensor layout, before any work.
+    layout = SensorLayout.load(config_dir() / task_settings.sensors)
+    mapping = (args.mapping or run.mapping) if args.kind == "evorbc" else None
+    initial_network = None
+    if args.init_from:
+        initial_network = load_initial_network(args.init_from, robot, args.kind, mapping, layout)
     settings = EvolutionSettings(
         kind=args.kind,
         robot=robot,
@@ -225,9 +240,11 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         neat_file=str(neat_file),
         neat_sha256=file_sha256(neat_file),
         task=task_settings.as_dict(),
-        mapping=(args.mapping or run.mapping) if args.kind == "evorbc" else None,
+        mapping=mapping,
         repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
         **run.selection(),
+        initial_network=network_fingerprint(initial_network) if initial_network else None,
+        initial_network_file=args.init_from,
     )
     check_distinct(
         {
@@ -238,10 +255,9 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             "--config": args.config,
             "--neat-config": args.neat_config,
             "--task": args.task,
+            "--init-from": args.init_from,
         }
     )
-    # The NEAT settings and the task's memory, before any work.
-    layout = SensorLayout.load(config_dir() / task_settings.sensors)
     n_outputs = 2 if args.kind == "evorbc" else lookup(robot).n_parameters
     pop_size = load_neat_config(neat_file, layout.n_inputs, n_outputs).pop_size
     check_evolution_memory(
@@ -256,7 +272,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     )
     every = args.checkpoint_every or run.checkpoint_every
     with exclusive_outputs({"--out": out, "--checkpoint": args.checkpoint}):
-        result = _run(args, settings, every, repertoire, checkpoint)
+        result = _run(args, settings, every, repertoire, checkpoint, initial_network)
 
         def write() -> None:
             task = make_task(task_settings, robot, workers=1)

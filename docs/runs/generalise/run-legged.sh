@@ -10,18 +10,20 @@
 # command resumes from the checkpoint; the checkpoint is kept at the end, so that another
 # post-selection rule can be tried on the finished run (delete NAME-seedS.arbitrator.json
 # and run again with other SETTINGS: docs/design.md section 13).
-#   usage: sh docs/runs/generalise/run-legged.sh ROBOT NAME [SEED] [GENERATIONS] [NEAT.ini] [SETTINGS.yaml] [OWN]
+# INIT starts the run from that arbitrator file's network (`--init-from`, docs/design.md
+# section 8) instead of random networks.
+#   usage: sh docs/runs/generalise/run-legged.sh ROBOT NAME [SEED] [GENERATIONS] [NEAT.ini] [SETTINGS.yaml] [OWN] [INIT]
 #   e.g.   sh docs/runs/generalise/run-legged.sh hexapod hexapod-t90-s2 1 200 \
 #            docs/runs/generalise/tasks/hexapod-pop100.ini docs/runs/generalise/tasks/hexapod-reach.yaml
 # (Edit this file only by replacing it, never in place: a running sh reads it as it goes.)
 set -e
 robot=$1; name=$2; seed=${3:-1}; gens=${4:-200}; neat=${5:+--neat-config $5}; settings=${6:+--config $6}
-own=${7:+--mazes $7}
+own=${7:+--mazes $7}; init=${8:+--init-from $8}
 dir=docs/runs/generalise
 out=$dir/$name-seed$seed
 if [ ! -f $out.arbitrator.json ]; then
   .venv/bin/evorbc-evolve arbitrator --repertoire evorbc_ros/data/$robot.repertoire.json \
-    --task $dir/tasks/$name.yaml --seed $seed --generations $gens --quiet $neat $settings \
+    --task $dir/tasks/$name.yaml --seed $seed --generations $gens --quiet $neat $settings $init \
     --keep-checkpoint --out $out.arbitrator.json --checkpoint $out.checkpoint.json
 fi
 for suite in own held ownr heldr own100; do

@@ -1,0 +1,192 @@
+"""Start a NEAT run from an evolved network (``--init-from``): fine-tuning a controller.
+
+A run usually starts from neat-python's random minimal networks. Started from a
+controller instead (an arbitrator file), its first population is that network once,
+unchanged, and ``pop_size - 1`` copies mutated once each by the run's own NEAT settings,
+as children of it would be. From there it is an ordinary run: the same selection,
+speciation, checkpoints and post-evaluation. This is how a controller evolved on one task
+(the paper protocol's single start, say) is carried on to a harder one (random starts
+anywhere in the maze) without losing what it already does (docs/design.md section 8,
+"Starting from a controller").
+
+The network's inputs are matched to the run's sensor layout **by name** (``range_000``,
+``goal_bearing``, ...; a range input's name holds its beam angle): a layout that adds inputs
+(the motion input, more beams) starts with them unconnected, and one that lacks an input the
+network reads is refused. So is a layout in which an input of the same name would measure
+something else (another range, beam width or goal-sector width). Its hidden nodes keep
+their keys; new nodes are numbered after them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from itertools import count
+
+import neat
+
+from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
+from evorbc_ros.config import ConfigError
+from evorbc_ros.network import ConnectionSpec, NetworkSpec
+from evorbc_ros.sensors import SensorLayout
+from offline_evolution.arbitrator.neat_state import check_genome_dict, genome_to_dict
+
+
+def network_fingerprint(network: NetworkSpec) -> str:
+    """SHA-256 of a network's plain-data form: what a run starts from, wherever it is kept."""
+    return hashlib.sha256(json.dumps(network.to_dict(), sort_keys=True).encode()).hexdigest()
+
+
+def load_initial_network(
+    path: str | os.PathLike,
+    robot: str,
+    kind: str,
+    mapping: str | None,
+    layout: SensorLayout,
+) -> NetworkSpec:
+    """The network of an arbitrator file, with its inputs renumbered for ``layout``.
+
+    Args:
+        path: an arbitrator file (JSON, validated as every reader validates it).
+        robot, kind, mapping: the run's; the file's must be the same (a network's outputs
+            are a point of that robot's behaviour space under that mapping, or its
+            locomotion parameters for the standard-NEAT baseline).
+        layout: the run's sensor layout; input ``-(i + 1)`` is its ``i``-th input name.
+
+    Raises:
+        ConfigError: one line naming the file and what does not fit.
+    """
+    try:
+        arb = ArbitratorFile.load(path)
+    except ArbitratorError as e:
+        raise ConfigError(str(e)) from None
+    for what, theirs, ours in (("robot", arb.robot, robot), ("kind", arb.kind, kind)):
+        if theirs != ours:
+            raise ConfigError(f"{path}: its {what} is {theirs!r}, this run's is {ours!r}")
+    if kind == "evorbc" and arb.mapping != mapping:
+        raise ConfigError(
+            f"{path}: its mapping is {arb.mapping!r}, this run's is {mapping!r} "
+            "(give --mapping to match)"
+        )
+    theirs, ours = arb.sensors.input_names(), layout.input_names()
+    missing = [name for name in theirs if name not in ours]
+    if missing:
+        raise ConfigError(
+            f"{path}: the network reads {', '.join(missing)}, which the run's sensor layout "
+            f"does not give (it gives {', '.join(ours)})"
+        )
+    differs = _measured_differently(arb.sensors.to_dict(), layout.to_dict())
+    if differs:
+        raise ConfigError(f"{path}: {differs}, so inputs of the same name measure differently")
+    key = {-(i + 1): -(ours.index(name) + 1) for i, name in enumerate(theirs)}
+    net = arb.network
+    return NetworkSpec(
+        input_keys=tuple(-(i + 1) for i in range(len(ours))),
+        output_keys=net.output_keys,
+        nodes=net.nodes,
+        connections=tuple(
+            ConnectionSpec(key.get(c.source, c.source), c.target, c.weight, c.enabled)
+            for c in net.connections
+        ),
+        recurrent=net.recurrent,
+    )
+
+
+#: Sensor settings that say which inputs a group has (their directions), not what each
+#: input measures: they may differ between a network's layout and the run's.
+_WHICH_INPUTS = ("angles_deg", "centres_deg")
+
+
+def _measured_differently(theirs: dict, ours: dict) -> str | None:
+    """The first sensor setting of ``theirs`` that ``ours`` sets otherwise, said in words."""
+    for group, settings in theirs.items():
+        mine = ours.get(group)
+        if not isinstance(settings, dict):
+            if mine != settings:
+                return f"its {group} is {settings!r}, the run's sensor layout has {mine!r}"
+            continue
+        for key, value in settings.items():
+            if key in _WHICH_INPUTS:
+                continue
+            other = mine.get(key) if isinstance(mine, dict) else None
+            if other != value:
+                return f"its {group}.{key} is {value!r}, the run's sensor layout has {other!r}"
+    return None
+
+
+def genome_from_network(network: NetworkSpec, key: int, config: neat.Config):
+    """A neat-python genome that computes ``network`` (genes in the network's order).
+
+    Connections get the innovation numbers of ``config``'s tracker for an initial
+    connection between the same nodes, so all copies of one network line up in
+    crossover. Call it after the population (and so the tracker) exists.
+
+    Raises:
+        ConfigError: the network does not fit the NEAT settings (its inputs or outputs,
+            feed-forward or recurrent, or an activation they do not offer).
+    """
+    gc = config.genome_config
+    if tuple(network.input_keys) != tuple(gc.input_keys):
+        raise ConfigError(
+            f"the network has {len(network.input_keys)} inputs, the run {gc.num_inputs}"
+        )
+    if tuple(network.output_keys) != tuple(gc.output_keys):
+        raise ConfigError(
+            f"the network has {len(network.output_keys)} outputs, the run {gc.num_outputs}"
+        )
+    if network.recurrent == gc.feed_forward:
+        kind = "recurrent" if network.recurrent else "feed-forward"
+        raise ConfigError(f"the network is {kind} and the NEAT settings are not")
+    genome = config.genome_type(key)
+    for n in network.nodes:
+        node = gc.node_gene_type(n.key)
+        # Attributes a NetworkSpec does not hold (neat-python's CTRNN time constant) are
+        # drawn as for a new node: they do not change what a network of these settings
+        # computes.
+        node.init_attributes(gc)
+        for name in ("bias", "response", "activation", "aggregation"):
+            setattr(node, name, getattr(n, name))
+        genome.nodes[n.key] = node
+    for c in network.connections:
+        innovation = gc.innovation_tracker.get_innovation_number(
+            c.source, c.target, "initial_connection"
+        )
+        conn = gc.connection_gene_type((c.source, c.target), innovation=innovation)
+        conn.init_attributes(gc)
+        conn.weight, conn.enabled = c.weight, c.enabled
+        genome.connections[conn.key] = conn
+    try:  # activations and aggregations the NEAT settings offer, every node known
+        check_genome_dict(genome_to_dict(genome), config, "network.")
+    except ValueError as e:
+        raise ConfigError(str(e)) from None
+    return genome
+
+
+def seed_population(population: neat.Population, network: NetworkSpec) -> None:
+    """Replace a new population's genomes with ``network`` and mutated copies of it.
+
+    ``population`` is one ``neat.Population(config, seed=...)`` has just made (generation
+    0, its random state seeded by the run): the first genome key gets ``network`` as it
+    is, every other key a copy mutated once. The species are then formed anew. Seeded:
+    the same run seed and network give the same population.
+
+    Raises:
+        ConfigError: the network does not fit the NEAT settings (see
+            :func:`genome_from_network`).
+    """
+    config = population.config
+    gc = config.genome_config
+    # New nodes are numbered after every node the network already has.
+    highest = max([n.key for n in network.nodes] + list(gc.output_keys))
+    pending = None if gc.node_indexer is None else next(gc.node_indexer)
+    gc.node_indexer = count(max(highest + 1, pending or 0))
+    genomes = {}
+    for i, key in enumerate(sorted(population.population)):
+        genome = genome_from_network(network, key, config)
+        if i:
+            genome.mutate(gc)
+        genomes[key] = genome
+    population.population = genomes
+    population.species = config.species_set_type(config.species_set_config, population.reporters)
+    population.species.speciate(config, population.population, population.generation)
