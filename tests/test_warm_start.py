@@ -135,8 +135,11 @@ def test_a_warm_started_run_resumes_to_the_straight_result(tmp_path, small_neat_
     # A checkpoint of a warm-started run is another run's for a cold start, and back.
     evolve(settings, repertoire, checkpoint=ckpt, keep_checkpoint=True, initial_network=network)
     cold = dataclasses.replace(settings, initial_network=None, initial_network_file=None)
-    with pytest.raises(CheckpointError, match="initial_network"):
+    with pytest.raises(CheckpointError, match="the run started from the network of"):
         evolve(cold, repertoire, checkpoint=ckpt)
+    evolve(cold, repertoire, checkpoint=tmp_path / "cold.json", keep_checkpoint=True)
+    with pytest.raises(CheckpointError, match="started from random networks"):
+        evolve(settings, repertoire, checkpoint=tmp_path / "cold.json", initial_network=network)
 
 
 def test_a_checkpoint_from_before_warm_starts_resumes(tmp_path, small_neat_file, repertoire):
@@ -155,9 +158,15 @@ def test_the_network_must_be_the_one_the_settings_name(small_neat_file, repertoi
     other = load_initial_network(
         DATA / "4ws-5.arbitrator.json", "4ws-5", "evorbc", "polar", layout("4ws-p8m")
     )
-    for given in (None, other):
-        with pytest.raises(ConfigError, match="not the one the run settings name"):
-            Evolution(settings, repertoire, initial_network=given)
+    with pytest.raises(ConfigError, match="not the one the run settings name"):
+        Evolution(settings, repertoire, initial_network=other)
+    # Without it, such a run can only continue from a checkpoint.
+    run = Evolution(settings, repertoire)
+    try:
+        with pytest.raises(ValueError, match="needs it or a checkpoint"):
+            run.step()
+    finally:
+        run.close()
 
 
 def test_inputs_are_matched_by_name():
@@ -210,7 +219,7 @@ def test_the_cli_starts_from_a_file_and_records_it(
     network = ArbitratorFile.load(PAPER_4WS).network
     assert record == {"file": PAPER_4WS.name, "fingerprint": network_fingerprint(network)}
     capsys.readouterr()
-    # bad files: one line, exit code 2, nothing written
+    # bad files: one line, exit status 1, nothing written
     bad = tmp_path / "bad.json"
     bad.write_text("{}")
     for given, message in (
@@ -223,3 +232,109 @@ def test_the_cli_starts_from_a_file_and_records_it(
         assert code == 1 and message in err and "Traceback" not in err
         assert len(err.strip().splitlines()) == 1
         assert not (tmp_path / "b.json").exists()
+
+
+def test_the_first_speciation_uses_the_settings_threshold(small_neat_file, repertoire):
+    # The discarded random population was speciated once (the threshold steered one step);
+    # the seeded one is speciated from the settings' value again, as a cold run's was.
+    settings, network = warm(small_neat_file, repertoire)
+    warm_run = Evolution(settings, repertoire, initial_network=network)
+    cold_run = Evolution(evolution_settings(small_neat_file, repertoire, SMALL_TASK), repertoire)
+    try:
+        configured = load_neat_config(small_neat_file, 10, 2).species_set_config
+        step = configured.threshold_step
+        for run in (warm_run, cold_run):
+            moved = run.config.species_set_config.compatibility_threshold
+            assert abs(moved - configured.compatibility_threshold) == pytest.approx(step)
+    finally:
+        warm_run.close()
+        cold_run.close()
+
+
+def edited_paper_file(tmp_path, change) -> str:
+    data = json.loads(PAPER_4WS.read_text())
+    change(data)
+    path = tmp_path / f"{change.__name__}.arbitrator.json"
+    path.write_text(json.dumps(data))
+    return path
+
+
+def test_a_file_whose_inputs_are_keyed_in_another_order_computes_the_same(tmp_path):
+    import numpy as np
+
+    def reverse(data):
+        data["network"]["inputs"].reverse()
+
+    path = edited_paper_file(tmp_path, reverse)
+    network = load_initial_network(path, "4ws-5", "evorbc", "polar", layout("4ws"))
+    theirs = ArbitratorFile.load(path).network.compile()
+    ours = network.compile()
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        x = rng.random(10)
+        np.testing.assert_array_equal(ours.activate(x), theirs.activate(x))
+    assert not np.array_equal(
+        ours.activate(x), ArbitratorFile.load(PAPER_4WS).network.compile().activate(x)
+    )
+
+
+def test_a_run_resumed_without_the_network_says_what_to_give(tmp_path, small_neat_file, repertoire):
+    settings, network = warm(small_neat_file, repertoire, generations=2)
+    ckpt = tmp_path / "c.json"
+    evolve(settings, repertoire, checkpoint=ckpt, keep_checkpoint=True, initial_network=network)
+    cold = dataclasses.replace(settings, initial_network=None, initial_network_file=None)
+    with pytest.raises(CheckpointError, match=f"give --init-from {PAPER_4WS} to resume it"):
+        evolve(cold, repertoire, checkpoint=ckpt)
+    # A tool that reopens the kept checkpoint from its settings alone (candidates.py) can.
+    run = Evolution(settings, repertoire)
+    try:
+        run.restore(ckpt)
+        assert run.generation == 2 and run.best is not None
+    finally:
+        run.close()
+
+
+def test_an_unfitting_network_is_refused_before_any_work(tmp_path, capsys, small_task_file):
+    def tanh(data):
+        data["network"]["nodes"][-1]["activation"] = "tanh"
+
+    def negative(data):  # a hidden node keyed like the motion input an added layout has
+        node = next(n for n in data["network"]["nodes"] if n["key"] > 1)
+        old, node["key"] = node["key"], -11
+        for c in data["network"]["connections"]:
+            c["source"] = -11 if c["source"] == old else c["source"]
+            c["target"] = -11 if c["target"] == old else c["target"]
+
+    recurrent = config_dir() / "neat" / "4ws-recurrent.ini"
+    cases = [
+        (PAPER_4WS, recurrent, "feed_forward = False"),
+        (edited_paper_file(tmp_path, tanh), None, "activation 'tanh', which"),
+        (edited_paper_file(tmp_path, negative), None, "node keys must be 0 or more"),
+    ]
+    for given, neat_file, message in cases:
+        argv = ["arbitrator", "--repertoire", DATA / "4ws-5.repertoire.json", "--quiet"]
+        argv += ["--task", small_task_file, "--init-from", given, "--out", tmp_path / "b.json"]
+        if neat_file:
+            argv += ["--neat-config", neat_file]
+        code = main([str(a) for a in argv])
+        err = capsys.readouterr().err
+        assert code == 1 and f"{given}: " in err and message in err, err
+        assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+        assert not (tmp_path / "b.json").exists() and not (tmp_path / "b.json.lock").exists()
+
+
+def test_inputs_must_point_the_same_way_and_have_distinct_names(tmp_path):
+    hexapod = DATA / "hexapod.arbitrator.json"
+    data = layout("hexapod").to_dict()
+    data["rangefinders"]["angles_deg"] = [-75, -37.5, 0, 38.0, 75]  # still range_038
+    with pytest.raises(
+        ConfigError, match=r"its range_038 points at 37\.5 deg, the run's at 38 deg"
+    ):
+        load_initial_network(
+            hexapod, "hexapod", "evorbc", "polar", SensorLayout.from_dict(data, "t")
+        )
+    data["rangefinders"]["angles_deg"] = [-75, 0.2, 0, 37.5, 75]
+    with pytest.raises(ConfigError, match="two inputs named range_000"):
+        load_initial_network(
+            hexapod, "hexapod", "evorbc", "polar", SensorLayout.from_dict(data, "t")
+        )

@@ -261,7 +261,8 @@ class Evolution:
             for ``settings.robot``. A task given here stays the caller's to close.
         initial_network: the network ``settings.initial_network`` fingerprints, for a run
             that starts from it (:func:`~offline_evolution.arbitrator.warm_start.
-            seed_population`), its inputs numbered for the task's sensor layout.
+            seed_population`), its inputs numbered for the task's sensor layout. Without
+            it such a run can only :meth:`restore` a checkpoint.
 
     Raises:
         ConfigError: the initial network does not fit the run (or is not the one
@@ -310,10 +311,14 @@ class Evolution:
             n_outputs = len(self.task.parameter_specs)
         self.controller = self.task.controller(settings.kind, repertoire, settings.mapping)
         self.config = load_neat_config(settings.neat_file, self.task.layout.n_inputs, n_outputs)
+        threshold = self.config.species_set_config.compatibility_threshold
         self.population = neat.Population(self.config, seed=settings.seed)
-        if settings.initial_network is not None or initial_network is not None:
+        # A run that starts from a network and is not given it can only continue from a
+        # checkpoint (restore() then compares the fingerprints).
+        self._needs_restore = settings.initial_network is not None and initial_network is None
+        if initial_network is not None:
             try:
-                self._start_from(initial_network)
+                self._start_from(initial_network, threshold)
             except ConfigError:
                 self.close()
                 raise
@@ -330,15 +335,14 @@ class Evolution:
         # moved or renamed one is not.
         self._task_by_content = _inputs_by_content(settings.as_dict())["task"]
 
-    def _start_from(self, network: NetworkSpec | None) -> None:
+    def _start_from(self, network: NetworkSpec, threshold: float) -> None:
         """Make the first population from ``network`` (the one the settings fingerprint)."""
-        wanted = self.settings.initial_network
-        if network is None or wanted is None or network_fingerprint(network) != wanted:
+        if network_fingerprint(network) != self.settings.initial_network:
             raise ConfigError(
                 "the initial network given is not the one the run settings name "
                 f"({self.settings.initial_network_file or 'none'})"
             )
-        seed_population(self.population, network)
+        seed_population(self.population, network, threshold)
 
     def close(self) -> None:
         """Close the task if this run made it (a task given to it is the caller's)."""
@@ -413,6 +417,8 @@ class Evolution:
 
     def step(self) -> GenerationStats:
         """Evaluate the current generation and breed the next one."""
+        if self._needs_restore:
+            raise ValueError("a run that starts from a network needs it or a checkpoint")
         start = time.perf_counter()
         # A finished run resumed with more generations: its post-evaluation's rows are of
         # another hall of fame now, so they are not kept in the next checkpoints.
@@ -549,12 +555,15 @@ class Evolution:
         now = {k: v for k, v in self.settings.as_dict().items() if k not in ignored}
         saved = _without_selection(saved)
         now = _without_selection({**now, "task": self._task_by_content})
+        if saved.get("initial_network") != now.get("initial_network"):
+            raise CheckpointError(f"{path}: {_started_elsewhere(data['settings'], now)}")
         mismatch = settings_mismatch(saved, now)
         if mismatch:
             raise CheckpointError(f"{path}: was written by a different run ({mismatch})")
         check_same_robot(path, data.get("simulation"), self.simulation)
         try:
             self.population = population_from_dict(require(data, "population", dict), self.config)
+            self._needs_restore = False
             return self._restore_record(data, path)
         except CheckpointError:
             raise
@@ -656,18 +665,24 @@ def evolve(
         final_progress: the same for its finalists' round (``post_finalists``; default
             ``post_progress``).
         initial_network: the network a run with ``settings.initial_network`` starts from
-            (:mod:`~offline_evolution.arbitrator.warm_start`); a resumed run only checks it
-            against the checkpoint's fingerprint.
+            (:mod:`~offline_evolution.arbitrator.warm_start`); a run that resumes from
+            ``checkpoint`` only checks its fingerprint (the checkpoint holds the population).
 
     Raises:
         RepertoireError: the repertoire was evolved for another simulated robot.
         CheckpointError: the checkpoint exists but belongs to another run or is corrupt.
         ConfigError: the initial network does not fit the run.
     """
-    run = Evolution(settings, repertoire, workers, repertoire_source, task, initial_network)
+    resuming = checkpoint is not None and os.path.exists(checkpoint)
+    given = initial_network
+    if resuming and given is not None and network_fingerprint(given) != settings.initial_network:
+        raise ConfigError("the initial network given is not the one the run settings name")
+    # A resumed population comes from the checkpoint: the network need not seed one.
+    start = None if resuming else initial_network
+    run = Evolution(settings, repertoire, workers, repertoire_source, task, start)
     try:
         elapsed = 0.0
-        if checkpoint is not None and os.path.exists(checkpoint):
+        if resuming:
             elapsed = run.restore(checkpoint)
             if on_resume is not None:
                 on_resume(run.generation)
@@ -702,6 +717,17 @@ def evolve(
         return result
     finally:
         run.close()
+
+
+def _started_elsewhere(saved: dict, now: dict) -> str:
+    """Why a checkpoint's starting network is not this run's, and what to give instead."""
+    fingerprint, source = saved.get("initial_network"), saved.get("initial_network_file")
+    if not fingerprint:
+        return "was written by a run that started from random networks, not from --init-from"
+    started = f"the run started from the network of {source} ({str(fingerprint)[:12]})"
+    if now.get("initial_network") is None:
+        return f"{started}: give --init-from {source} to resume it"
+    return f"{started}, not from the one given"
 
 
 def _path(checkpoint: str | os.PathLike | None) -> str | None:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 from itertools import count
 
@@ -28,7 +29,7 @@ import neat
 
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.config import ConfigError
-from evorbc_ros.network import ConnectionSpec, NetworkSpec
+from evorbc_ros.network import ConnectionSpec, NetworkError, NetworkSpec
 from evorbc_ros.sensors import SensorLayout
 from offline_evolution.arbitrator.neat_state import check_genome_dict, genome_to_dict
 
@@ -44,6 +45,8 @@ def load_initial_network(
     kind: str,
     mapping: str | None,
     layout: SensorLayout,
+    config: neat.Config | None = None,
+    neat_source: str = "the NEAT settings",
 ) -> NetworkSpec:
     """The network of an arbitrator file, with its inputs renumbered for ``layout``.
 
@@ -53,6 +56,8 @@ def load_initial_network(
             are a point of that robot's behaviour space under that mapping, or its
             locomotion parameters for the standard-NEAT baseline).
         layout: the run's sensor layout; input ``-(i + 1)`` is its ``i``-th input name.
+        config: the run's NEAT settings, which the network must fit (see
+            :func:`check_fits`); ``neat_source`` names them in errors.
 
     Raises:
         ConfigError: one line naming the file and what does not fit.
@@ -69,6 +74,11 @@ def load_initial_network(
             f"{path}: its mapping is {arb.mapping!r}, this run's is {mapping!r} "
             "(give --mapping to match)"
         )
+    for where, named in ((str(path), arb.sensors), ("the run's sensor layout", layout)):
+        names = named.input_names()
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise ConfigError(f"{path}: {where} has two inputs named {', '.join(twice)}")
     theirs, ours = arb.sensors.input_names(), layout.input_names()
     missing = [name for name in theirs if name not in ours]
     if missing:
@@ -76,12 +86,17 @@ def load_initial_network(
             f"{path}: the network reads {', '.join(missing)}, which the run's sensor layout "
             f"does not give (it gives {', '.join(ours)})"
         )
-    differs = _measured_differently(arb.sensors.to_dict(), layout.to_dict())
+    differs = _measured_differently(arb.sensors, layout)
     if differs:
         raise ConfigError(f"{path}: {differs}, so inputs of the same name measure differently")
-    key = {-(i + 1): -(ours.index(name) + 1) for i, name in enumerate(theirs)}
     net = arb.network
-    return NetworkSpec(
+    # The file's i-th input key reads its i-th input name; here that name's place in the
+    # run's layout gives the key (neat-python's input i is key -(i + 1)).
+    key = {k: -(ours.index(n) + 1) for k, n in zip(net.input_keys, theirs, strict=True)}
+    hidden = [n.key for n in net.nodes if n.key < 0]
+    if hidden:
+        raise ConfigError(f"{path}: node keys must be 0 or more (neat-python's), got {hidden}")
+    network = NetworkSpec(
         input_keys=tuple(-(i + 1) for i in range(len(ours))),
         output_keys=net.output_keys,
         nodes=net.nodes,
@@ -91,6 +106,42 @@ def load_initial_network(
         ),
         recurrent=net.recurrent,
     )
+    try:
+        network.compile()
+    except NetworkError as e:
+        raise ConfigError(f"{path}: network: {e}") from None
+    if config is not None:
+        problem = check_fits(network, config, neat_source)
+        if problem:
+            raise ConfigError(f"{path}: {problem}")
+    return network
+
+
+def check_fits(network: NetworkSpec, config: neat.Config, neat_source: str) -> str | None:
+    """Why ``network`` cannot start a run of ``config`` (in words), or None if it can."""
+    gc = config.genome_config
+    if tuple(network.input_keys) != tuple(gc.input_keys):
+        return f"the network has {len(network.input_keys)} inputs, the run {gc.num_inputs}"
+    if tuple(network.output_keys) != tuple(gc.output_keys):
+        return (
+            f"the network's outputs are keyed {list(network.output_keys)}, {neat_source} key "
+            f"them {list(gc.output_keys)}"
+        )
+    if network.recurrent == gc.feed_forward:
+        kind = "recurrent" if network.recurrent else "feed-forward"
+        return f"the network is {kind}, and {neat_source} set feed_forward = {gc.feed_forward}"
+    for node in network.nodes:
+        for attribute, options in (
+            ("activation", gc.activation_options),
+            ("aggregation", gc.aggregation_options),
+        ):
+            value = getattr(node, attribute)
+            if value not in options:
+                return (
+                    f"node {node.key} has {attribute} {value!r}, which {neat_source} do not "
+                    f"offer ({attribute}_options: {' '.join(options)})"
+                )
+    return None
 
 
 #: Sensor settings that say which inputs a group has (their directions), not what each
@@ -98,10 +149,18 @@ def load_initial_network(
 _WHICH_INPUTS = ("angles_deg", "centres_deg")
 
 
-def _measured_differently(theirs: dict, ours: dict) -> str | None:
+def _directions(layout: SensorLayout) -> dict[str, float]:
+    """Each direction-named input's exact direction (rad; names round it to a degree)."""
+    angles = list(layout.rangefinders.angles) if layout.rangefinders else []
+    angles += list(layout.goal_sectors.centres) if layout.goal_sectors else []
+    return dict(zip(layout.input_names(), angles, strict=False))
+
+
+def _measured_differently(theirs: SensorLayout, ours: SensorLayout) -> str | None:
     """The first sensor setting of ``theirs`` that ``ours`` sets otherwise, said in words."""
-    for group, settings in theirs.items():
-        mine = ours.get(group)
+    mine_all = ours.to_dict()
+    for group, settings in theirs.to_dict().items():
+        mine = mine_all.get(group)
         if not isinstance(settings, dict):
             if mine != settings:
                 return f"its {group} is {settings!r}, the run's sensor layout has {mine!r}"
@@ -112,6 +171,13 @@ def _measured_differently(theirs: dict, ours: dict) -> str | None:
             other = mine.get(key) if isinstance(mine, dict) else None
             if other != value:
                 return f"its {group}.{key} is {value!r}, the run's sensor layout has {other!r}"
+    ours_at = _directions(ours)
+    for name, angle in _directions(theirs).items():
+        if abs(math.remainder(angle - ours_at[name], math.tau)) > 1e-9:
+            return (
+                f"its {name} points at {math.degrees(angle):g} deg, the run's at "
+                f"{math.degrees(ours_at[name]):g} deg"
+            )
     return None
 
 
@@ -123,21 +189,12 @@ def genome_from_network(network: NetworkSpec, key: int, config: neat.Config):
     crossover. Call it after the population (and so the tracker) exists.
 
     Raises:
-        ConfigError: the network does not fit the NEAT settings (its inputs or outputs,
-            feed-forward or recurrent, or an activation they do not offer).
+        ConfigError: the network does not fit the NEAT settings (:func:`check_fits`).
     """
     gc = config.genome_config
-    if tuple(network.input_keys) != tuple(gc.input_keys):
-        raise ConfigError(
-            f"the network has {len(network.input_keys)} inputs, the run {gc.num_inputs}"
-        )
-    if tuple(network.output_keys) != tuple(gc.output_keys):
-        raise ConfigError(
-            f"the network has {len(network.output_keys)} outputs, the run {gc.num_outputs}"
-        )
-    if network.recurrent == gc.feed_forward:
-        kind = "recurrent" if network.recurrent else "feed-forward"
-        raise ConfigError(f"the network is {kind} and the NEAT settings are not")
+    problem = check_fits(network, config, "the NEAT settings")
+    if problem:
+        raise ConfigError(problem)
     genome = config.genome_type(key)
     for n in network.nodes:
         node = gc.node_gene_type(n.key)
@@ -156,20 +213,24 @@ def genome_from_network(network: NetworkSpec, key: int, config: neat.Config):
         conn.init_attributes(gc)
         conn.weight, conn.enabled = c.weight, c.enabled
         genome.connections[conn.key] = conn
-    try:  # activations and aggregations the NEAT settings offer, every node known
+    try:  # every connection joins nodes the genome has (the network compiled: a safeguard)
         check_genome_dict(genome_to_dict(genome), config, "network.")
     except ValueError as e:
         raise ConfigError(str(e)) from None
     return genome
 
 
-def seed_population(population: neat.Population, network: NetworkSpec) -> None:
+def seed_population(
+    population: neat.Population, network: NetworkSpec, compatibility_threshold: float
+) -> None:
     """Replace a new population's genomes with ``network`` and mutated copies of it.
 
     ``population`` is one ``neat.Population(config, seed=...)`` has just made (generation
     0, its random state seeded by the run): the first genome key gets ``network`` as it
-    is, every other key a copy mutated once. The species are then formed anew. Seeded:
-    the same run seed and network give the same population.
+    is, every other key a copy mutated once. The species are then formed anew, from
+    ``compatibility_threshold``, the settings' value before the discarded random
+    population was speciated (a species set that steers the threshold moved it then).
+    Seeded: the same run seed and network give the same population.
 
     Raises:
         ConfigError: the network does not fit the NEAT settings (see
@@ -188,5 +249,6 @@ def seed_population(population: neat.Population, network: NetworkSpec) -> None:
             genome.mutate(gc)
         genomes[key] = genome
     population.population = genomes
+    config.species_set_config.compatibility_threshold = compatibility_threshold
     population.species = config.species_set_type(config.species_set_config, population.reporters)
     population.species.speciate(config, population.population, population.generation)

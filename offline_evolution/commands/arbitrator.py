@@ -226,12 +226,17 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         misfit = maze.start_misfit(lookup(robot).footprint_radius, robot)
         if misfit:
             raise CliError(f"{args.task or run.task_path()}: mazes: {misfit}")
-    # The NEAT settings and the task's sensor layout, before any work.
+    # The NEAT settings, the task's sensor layout and a network to start from, before any
+    # work.
     layout = SensorLayout.load(config_dir() / task_settings.sensors)
+    n_outputs = 2 if args.kind == "evorbc" else lookup(robot).n_parameters
+    neat_config = load_neat_config(neat_file, layout.n_inputs, n_outputs)
     mapping = (args.mapping or run.mapping) if args.kind == "evorbc" else None
     initial_network = None
     if args.init_from:
-        initial_network = load_initial_network(args.init_from, robot, args.kind, mapping, layout)
+        initial_network = load_initial_network(
+            args.init_from, robot, args.kind, mapping, layout, neat_config, str(neat_file)
+        )
     settings = EvolutionSettings(
         kind=args.kind,
         robot=robot,
@@ -258,8 +263,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             "--init-from": args.init_from,
         }
     )
-    n_outputs = 2 if args.kind == "evorbc" else lookup(robot).n_parameters
-    pop_size = load_neat_config(neat_file, layout.n_inputs, n_outputs).pop_size
+    pop_size = neat_config.pop_size
     check_evolution_memory(
         task_settings,
         pop_size,
