@@ -146,7 +146,9 @@ def switching_arbitrator(task, rep, robot, neat_path, tries=20, evolution=None):
     return arb, outcomes[0], result
 
 
-def assert_lockstep_reproduces(tmp_path, domain, robot, maze, controller, episode_time):
+def assert_lockstep_reproduces(
+    tmp_path, domain, robot, maze, controller, episode_time, timeout=120.0
+):
     """Run the lockstep graph with ``controller`` (the fixture's arbitrator, repertoire,
     offline outcome and result) and assert it reproduces the offline episode: the same
     primitive at every cycle, at least 3 different ones, identical poses (bit for bit),
@@ -163,11 +165,12 @@ def assert_lockstep_reproduces(tmp_path, domain, robot, maze, controller, episod
         repertoire=rep_path,
         robot=robot,
     )
-    got = run.finish(timeout=120)
+    got = run.finish(timeout=timeout)
     choices = run.recorded_choices()
     cycles = assert_same_choices(choices, result)
     assert len(set(choices.tolist())) >= 3  # the arbitrator switched primitives
     trajectory = np.array(got["trajectory"])
     np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
     assert got["robot"] == robot and got["fitness"] == pytest.approx(outcome.fitness)
+    assert got["reached"] == outcome.reached
     return trajectory

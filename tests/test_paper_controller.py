@@ -90,7 +90,10 @@ def test_every_shipped_paper_arbitrator_exists_and_without_the_field_is_the_ship
         if not robot.paper_arbitrator:
             assert paper_arbitrator(robot.name) == default_arbitrator(robot.name)
             assert shipped_arbitrator(robot.name, paper=True) == shipped_arbitrator(robot.name)
-    assert registry.lookup("hexapod").paper_arbitrator == ""
+    assert registry.lookup("a1").paper_arbitrator == ""
+    # The generalising controllers ship with the paper-protocol ones beside them.
+    for robot in ("4ws-5", "hexapod"):
+        assert paper_arbitrator(robot).name == f"{robot}-paper.arbitrator.json"
     assert shipped_arbitrator("4ws-3", paper=True) == ""  # none ships
 
 

@@ -12,15 +12,19 @@ import pytest
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.config import config_dir
-from evorbc_ros.defaults import default_arbitrator, default_repertoire
+from evorbc_ros.defaults import DATA_DIR, default_arbitrator, default_repertoire
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.sensors import SensorLayout
 from offline_evolution.arbitrator.evolve import file_sha256
 from offline_evolution.arbitrator.settings import load_run_settings
 from offline_evolution.maze_task.task import MazeTaskSettings
 
-# robot: (its run settings in config/arbitrator, the --seed of the recorded command)
-RECIPES = {"4ws-5": ("4ws-generated.yaml", 4)}
+# robot: (its run settings in config/arbitrator, the --seed of the recorded command, the
+# file in evorbc_ros/data its --init-from names, or None)
+RECIPES = {
+    "4ws-5": ("4ws-generated.yaml", 4, None),
+    "hexapod": ("hexapod-anywhere-warm.yaml", 1, "hexapod-paper.arbitrator.json"),
+}
 
 
 @pytest.fixture(scope="module", params=sorted(RECIPES))
@@ -53,8 +57,25 @@ def test_the_shipped_controller_was_chosen_by_the_shipped_post_selection(shipped
     assert post["rule"] == run.post_rule
     assert post["hall_of_fame"] == run.hall_of_fame
     assert post["samples_per_maze"] == run.post_samples
-    assert post["snapshot_every"] == run.snapshot_every
+    assert post.get("snapshot_every", 0) == run.snapshot_every  # written when set
     assert post["nominal_watch"] == run.nominal_watch
+    assert post.get("finalists", 0) == run.post_finalists
+    assert post.get("final_samples_per_maze", 0) == run.post_final_samples
+
+
+def test_the_shipped_controller_records_the_network_it_started_from(shipped):
+    robot, arb, _, _ = shipped
+    source = RECIPES[robot][2]
+    if source is None:
+        assert "initial_network" not in arb.evolution
+        return
+    from offline_evolution.arbitrator.warm_start import network_fingerprint
+
+    record = arb.evolution["initial_network"]
+    assert record["file"] == source
+    started = ArbitratorFile.load(DATA_DIR / source)
+    assert record["fingerprint"] == network_fingerprint(started.network)
+    assert started.evolution["task"]["mazes"] == [robot]  # the paper protocol's own maze
 
 
 def test_the_shipped_controller_reads_the_shipped_layout_over_the_shipped_repertoire(shipped):

@@ -60,7 +60,7 @@ def warm(neat_file, repertoire, task=SMALL_TASK, **changes):
 
 @pytest.mark.parametrize(
     "file, robot, sensors",
-    [(PAPER_4WS, "4ws-5", "4ws"), (DATA / "hexapod.arbitrator.json", "hexapod", "hexapod")],
+    [(PAPER_4WS, "4ws-5", "4ws"), (DATA / "hexapod-paper.arbitrator.json", "hexapod", "hexapod")],
 )
 def test_a_genome_from_a_network_is_that_network(file, robot, sensors):
     import neat
@@ -170,7 +170,7 @@ def test_the_network_must_be_the_one_the_settings_name(small_neat_file, repertoi
 
 
 def test_inputs_are_matched_by_name():
-    hexapod = DATA / "hexapod.arbitrator.json"
+    hexapod = DATA / "hexapod-paper.arbitrator.json"
     plain = load_initial_network(hexapod, "hexapod", "evorbc", "polar", layout("hexapod"))
     moved = load_initial_network(hexapod, "hexapod", "evorbc", "polar", with_motion("hexapod"))
     # motion comes last: the file's inputs keep their keys and motion starts unconnected
@@ -224,7 +224,7 @@ def test_the_cli_starts_from_a_file_and_records_it(
     bad.write_text("{}")
     for given, message in (
         (bad, "not an arbitrator file"),
-        (DATA / "hexapod.arbitrator.json", "its robot is 'hexapod'"),
+        (DATA / "hexapod-paper.arbitrator.json", "its robot is 'hexapod'"),
         (tmp_path / "missing.json", "missing.json"),
     ):
         code = main([str(a) for a in [*argv, "--init-from", given, "--out", tmp_path / "b.json"]])
@@ -324,7 +324,7 @@ def test_an_unfitting_network_is_refused_before_any_work(tmp_path, capsys, small
 
 
 def test_inputs_must_point_the_same_way_and_have_distinct_names(tmp_path):
-    hexapod = DATA / "hexapod.arbitrator.json"
+    hexapod = DATA / "hexapod-paper.arbitrator.json"
     data = layout("hexapod").to_dict()
     data["rangefinders"]["angles_deg"] = [-75, -37.5, 0, 38.0, 75]  # still range_038
     with pytest.raises(

@@ -33,6 +33,9 @@ ROBOTS = (
         episode_bytes=16_000,
         shipped_repertoire="hexapod.repertoire.json",
         shipped_arbitrator="hexapod.arbitrator.json",
+        # Trained in the paper's setting only (paper Table I); the shipped one from it with
+        # starts anywhere in the maze (evorbc_ros/data/README.md, docs/generalisation.md).
+        paper_arbitrator="hexapod-paper.arbitrator.json",
         # The bridge simulates one design and one laser; a controller for another is
         # refused with the first setting that differs (docs/design.md section 11).
         design_check="sim_bridge.hexapod.design:check_controller",
