@@ -678,8 +678,8 @@ def evolve(
     if resuming and given is not None and network_fingerprint(given) != settings.initial_network:
         raise ConfigError("the initial network given is not the one the run settings name")
     # A resumed population comes from the checkpoint: the network need not seed one.
-    start = None if resuming else initial_network
-    run = Evolution(settings, repertoire, workers, repertoire_source, task, start)
+    seeds = None if resuming else initial_network
+    run = Evolution(settings, repertoire, workers, repertoire_source, task, seeds)
     try:
         elapsed = 0.0
         if resuming:
