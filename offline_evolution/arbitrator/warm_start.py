@@ -29,9 +29,9 @@ import neat
 
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.config import ConfigError
+from evorbc_ros.json_files import first_difference
 from evorbc_ros.network import ConnectionSpec, NetworkError, NetworkSpec
 from evorbc_ros.sensors import SensorLayout
-from offline_evolution.arbitrator.neat_state import check_genome_dict, genome_to_dict
 
 
 def network_fingerprint(network: NetworkSpec) -> str:
@@ -158,19 +158,20 @@ def _directions(layout: SensorLayout) -> dict[str, float]:
 
 def _measured_differently(theirs: SensorLayout, ours: SensorLayout) -> str | None:
     """The first sensor setting of ``theirs`` that ``ours`` sets otherwise, said in words."""
-    mine_all = ours.to_dict()
-    for group, settings in theirs.to_dict().items():
-        mine = mine_all.get(group)
-        if not isinstance(settings, dict):
-            if mine != settings:
-                return f"its {group} is {settings!r}, the run's sensor layout has {mine!r}"
-            continue
-        for key, value in settings.items():
-            if key in _WHICH_INPUTS:
-                continue
-            other = mine.get(key) if isinstance(mine, dict) else None
-            if other != value:
-                return f"its {group}.{key} is {value!r}, the run's sensor layout has {other!r}"
+
+    def measures(layout: SensorLayout, groups) -> dict:
+        data = layout.to_dict()
+        return {
+            g: {k: v for k, v in data[g].items() if k not in _WHICH_INPUTS}
+            if isinstance(data.get(g), dict)
+            else data.get(g)
+            for g in groups
+        }
+
+    groups = list(theirs.to_dict())
+    differs = first_difference(measures(theirs, groups), measures(ours, groups), "the file")
+    if differs:
+        return differs.removesuffix(" now") + " in the run's sensor layout"
     ours_at = _directions(ours)
     for name, angle in _directions(theirs).items():
         if abs(math.remainder(angle - ours_at[name], math.tau)) > 1e-9:
@@ -188,13 +189,9 @@ def genome_from_network(network: NetworkSpec, key: int, config: neat.Config):
     connection between the same nodes, so all copies of one network line up in
     crossover. Call it after the population (and so the tracker) exists.
 
-    Raises:
-        ConfigError: the network does not fit the NEAT settings (:func:`check_fits`).
+    The network must fit ``config`` (:func:`check_fits`; :func:`seed_population` checks).
     """
     gc = config.genome_config
-    problem = check_fits(network, config, "the NEAT settings")
-    if problem:
-        raise ConfigError(problem)
     genome = config.genome_type(key)
     for n in network.nodes:
         node = gc.node_gene_type(n.key)
@@ -213,10 +210,6 @@ def genome_from_network(network: NetworkSpec, key: int, config: neat.Config):
         conn.init_attributes(gc)
         conn.weight, conn.enabled = c.weight, c.enabled
         genome.connections[conn.key] = conn
-    try:  # every connection joins nodes the genome has (the network compiled: a safeguard)
-        check_genome_dict(genome_to_dict(genome), config, "network.")
-    except ValueError as e:
-        raise ConfigError(str(e)) from None
     return genome
 
 
@@ -233,11 +226,18 @@ def seed_population(
     Seeded: the same run seed and network give the same population.
 
     Raises:
-        ConfigError: the network does not fit the NEAT settings (see
-            :func:`genome_from_network`).
+        ConfigError: the network is inconsistent or does not fit the NEAT settings
+            (:func:`check_fits`).
     """
     config = population.config
     gc = config.genome_config
+    try:
+        network.compile()  # every connection joins nodes the network has
+    except NetworkError as e:
+        raise ConfigError(f"the initial network: {e}") from None
+    problem = check_fits(network, config, "the NEAT settings")
+    if problem:
+        raise ConfigError(problem)
     # New nodes are numbered after every node the network already has.
     highest = max([n.key for n in network.nodes] + list(gc.output_keys))
     pending = None if gc.node_indexer is None else next(gc.node_indexer)
