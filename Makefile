@@ -6,6 +6,10 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.evorbc-installed
 OUT    ?= demo-output
+# The checkout's evorbc_ros/ and sim_bridge/ folders are ROS package folders, not the Python
+# packages inside them: never import from the current folder (python -P; docs/design.md
+# section 10).
+export PYTHONSAFEPATH := 1
 
 .PHONY: demo demo-hexapod demo-a1 demo-repertoire demo-evolve test test-fast lint bench bench-generalise clean
 

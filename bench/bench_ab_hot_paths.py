@@ -134,7 +134,17 @@ def hexapod_episodes() -> float:
 
 def run_tree(tree: Path, figures: list[str]) -> dict:
     """:func:`measure` in a fresh process importing from ``tree``."""
-    env = dict(os.environ, PYTHONPATH=str(tree), EVORBC_CONFIG_DIR=str(tree / "config"))
+    # Trees before the ROS package folders (docs/design.md section 10) hold the Python
+    # packages at the top and find config/ through EVORBC_CONFIG_DIR; later ones one level
+    # down, with the settings inside evorbc_ros.
+    roots = [tree / "evorbc_ros", tree / "sim_bridge", tree]
+    nested = (tree / "evorbc_ros" / "evorbc_ros" / "__init__.py").is_file()
+    env = dict(
+        os.environ,
+        PYTHONPATH=os.pathsep.join(str(r) for r in (roots if nested else roots[2:])),
+        PYTHONSAFEPATH="1",
+        EVORBC_CONFIG_DIR=str(tree / "config"),
+    )
     done = subprocess.run(
         [sys.executable, str(Path(__file__).resolve()), "--measure", "--figures", *figures],
         cwd=tree,

@@ -1,8 +1,8 @@
 """Bring up the simulated graph: sim_bridge and the four evorbc nodes.
 
-    ros2 launch evorbc_ros sim.launch.py maze:=zigzag mode:=lockstep gui:=false
-    ros2 launch evorbc_ros sim.launch.py robot:=hexapod namespace:=robot1
-    ros2 launch evorbc_ros sim.launch.py --show-args
+    ros2 launch evorbc_bringup sim.launch.py maze:=zigzag mode:=lockstep gui:=false
+    ros2 launch evorbc_bringup sim.launch.py robot:=hexapod namespace:=robot1
+    ros2 launch evorbc_bringup sim.launch.py --show-args
 
 Which nodes run, with which parameters, for which robot, comes from
 :mod:`sim_bridge.graph`, shared with ``evorbc-sim`` and tested without ``launch``; this

@@ -21,12 +21,12 @@ import sys
 from collections.abc import Sequence
 
 from evorbc_ros.arbitrator import ArbitratorError
-from evorbc_ros.cli_support import OneLineParser, report_unexpected
 from evorbc_ros.config import ConfigError
 from evorbc_ros.repertoire import RepertoireError
 from offline_evolution.checkpoint import CheckpointError
 from offline_evolution.commands import arbitrator, evaluate, mazes, repertoire, replay
 from offline_evolution.commands.common import EXIT_ERROR, EXIT_INTERRUPTED, CliError
+from sim_bridge.cli_support import OneLineParser, report_unexpected
 from sim_bridge.cluster_pool import CLUSTER_VARIABLE, ClusterError
 
 

@@ -1,8 +1,20 @@
 """Shared fixtures."""
 
+import os
 import signal
 
 import pytest
+
+import evorbc_ros
+
+# Processes the tests start (`python -m offline_evolution.cli`, the nodes) must not import
+# the checkout's ROS package folders either.
+os.environ.setdefault("PYTHONSAFEPATH", "1")
+
+if getattr(evorbc_ros, "__file__", None) is None:
+    # The checkout's ROS package folder evorbc_ros/ shadowed the installed Python package:
+    # python put the current folder first on sys.path (docs/design.md section 10).
+    pytest.exit("run the tests with `make test`, `.venv/bin/pytest` or `python -P -m pytest`", 2)
 from study_helpers import run_study, write_tiny_study
 
 from offline_evolution.repertoire.map_elites import generate_repertoire

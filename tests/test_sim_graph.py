@@ -242,6 +242,7 @@ def test_evorbc_sim_starts_the_same_graph_with_the_parameter_files(monkeypatch):
 def test_node_commands_carry_the_file_the_namespace_and_the_overrides():
     cmd = bringup.node_command("m", {"a": True, "b": "", "c": 1.5}, NODES_FILE, "robot1")
     assert cmd[1:] == [
+        "-P",
         "-m",
         "m",
         "--ros-args",

@@ -12,6 +12,7 @@ from conftest import SMALL_TASK, evolution_settings
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.config import ConfigError, config_dir
+from evorbc_ros.defaults import DATA_DIR
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.sensors import SensorLayout
 from offline_evolution.arbitrator.evolve import Evolution, evolve, network_spec
@@ -25,7 +26,7 @@ from offline_evolution.arbitrator.warm_start import (
 from offline_evolution.checkpoint import CheckpointError, Interrupted
 from offline_evolution.cli import main
 
-DATA = config_dir().parent / "evorbc_ros" / "data"
+DATA = DATA_DIR
 PAPER_4WS = DATA / "4ws-5-paper.arbitrator.json"  # sensors/4ws.yaml, SMALL_TASK's layout
 
 

@@ -13,7 +13,7 @@ import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-from evorbc_ros.cli_support import integer_in
+from sim_bridge.cli_support import integer_in
 
 EXIT_ERROR = 1
 EXIT_INTERRUPTED = 130

@@ -10,7 +10,6 @@ from pathlib import Path
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
-from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.config import ConfigError
 from evorbc_ros.defaults import (
     PAPER_WITH_FILE,
@@ -23,6 +22,7 @@ from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
 from offline_evolution.commands.common import CliError, EpisodeProgress, at_least, count
 from offline_evolution.commands.replay import check_task, controller_inputs
 from offline_evolution.mazes.held_out import HELD_OUT_SEED  # never trained on
+from sim_bridge.cli_support import check_output_file
 
 #: The suite word for the mazes the controller was trained on (its task's mazes).
 PAPER = "paper"

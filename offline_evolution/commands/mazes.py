@@ -7,9 +7,9 @@ import json
 import math
 from pathlib import Path
 
-from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
 from offline_evolution.commands.common import CliError, at_least, count
+from sim_bridge.cli_support import check_output_file
 
 
 def add_parsers(sub) -> None:

@@ -7,7 +7,6 @@ import sys
 import time
 from pathlib import Path
 
-from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.registry import ROBOT_NAMES, lookup
 from offline_evolution.commands.common import (
@@ -22,6 +21,7 @@ from offline_evolution.commands.common import (
     running,
     write_then_discard,
 )
+from sim_bridge.cli_support import check_output_file
 
 
 def add_parsers(sub) -> None:

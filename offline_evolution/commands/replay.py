@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
-from evorbc_ros.cli_support import check_output_file
 from evorbc_ros.defaults import default_repertoire
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.registry import lookup
 from offline_evolution.commands.common import CliError, EpisodeProgress, at_least, count
+from sim_bridge.cli_support import check_output_file
 from sim_bridge.robots.design import check_simulation, simulation_mismatch
 
 #: How a user lets another repertoire fingerprint or sensor layout through.

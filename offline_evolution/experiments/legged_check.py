@@ -69,7 +69,7 @@ def cli(*args: str) -> None:
         SystemExit: the command failed (its own one-line error is above).
 
     """
-    cmd = [sys.executable, "-m", "offline_evolution.cli", *args]
+    cmd = [sys.executable, "-P", "-m", "offline_evolution.cli", *args]  # -P: design.md s. 10
     print("$ evorbc-evolve " + " ".join(args), flush=True)
     code = subprocess.run(cmd, check=False).returncode
     if code != 0:

@@ -21,8 +21,8 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from evorbc_ros.cli_support import OneLineParser, integer_in, report_unexpected
 from evorbc_ros.config import ConfigError
+from sim_bridge.cli_support import OneLineParser, integer_in, report_unexpected
 
 EXIT_ERROR = 1
 EXIT_INTERRUPTED = 130

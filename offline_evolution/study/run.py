@@ -42,6 +42,9 @@ from sim_bridge.cluster_pool import CLUSTER_VARIABLE
 RUN_FILE = "run.json"
 FORMAT = "evorbc-study-run"
 VERSION = 1
+#: ``evorbc-evolve`` as a command; -P: never import the checkout's ROS package folders
+#: from the current folder (docs/design.md section 10).
+CLI = (sys.executable, "-P", "-m", "offline_evolution.cli")
 #: Exit status of ``evorbc-evolve`` after Ctrl-C/SIGTERM: the checkpoint is saved.
 EXIT_INTERRUPTED = 130
 
@@ -107,7 +110,7 @@ def commands(run: Run, folder: Path, workers: int | None = None) -> list[list[st
     a run takes the CPUs it was given and no more.
     """
     v = run.values
-    cli = [sys.executable, "-m", "offline_evolution.cli"]
+    cli = list(CLI)
     seed = ["--seed", str(run.seed)]
     out = []
     if run.approach == "evorbc":
@@ -225,13 +228,15 @@ def execute(run: Run, results: Path, threads: int = 1, cluster: str | None = Non
             target = folder / cmd[cmd.index("--out") + 1]
             if target.exists() or target.with_name(target.name + ".xz").exists():
                 continue  # finished by an earlier attempt
-            log.write(f"$ evorbc-evolve {' '.join(cmd[3:])}\n")
+            log.write(f"$ evorbc-evolve {' '.join(cmd[len(CLI) :])}\n")
             log.flush()
             status = _run_command(cmd, folder, env, log)
             if status == EXIT_INTERRUPTED or status < 0:
                 raise RunInterrupted(str(run.path))
             if status != 0:
-                raise RunError(f"{run.path}: {cmd[3]} failed (status {status}): {_tail(folder)}")
+                raise RunError(
+                    f"{run.path}: {cmd[len(CLI)]} failed (status {status}): {_tail(folder)}"
+                )
     for name in ("repertoire.json", "arbitrator.json"):
         if (folder / name).exists():
             _xz(folder / name)
@@ -241,7 +246,7 @@ def execute(run: Run, results: Path, threads: int = 1, cluster: str | None = Non
         "format": FORMAT,
         "version": VERSION,
         "settings": run.recorded_settings(),
-        "commands": [" ".join(["evorbc-evolve", *c[3:]]) for c in commands(run, folder)],
+        "commands": [" ".join(["evorbc-evolve", *c[len(CLI) :]]) for c in commands(run, folder)],
         "seconds": round(wall, 3),
         "cpu_seconds": round(cpu, 3),
         "threads": threads,

@@ -4,7 +4,7 @@ Starts ``sim_bridge`` and the four evorbc nodes (``laser_sensor``, ``radar_senso
 ``arbitrator``, ``primitive_executor``) as processes on this machine, runs one maze
 episode, prints the result, writes a trajectory picture, and shuts everything down; Ctrl-C
 stops the run cleanly (status 130). The nodes and their parameters come from
-:mod:`sim_bridge.graph`, which ``ros2 launch evorbc_ros sim.launch.py`` uses too, so both
+:mod:`sim_bridge.graph`, which ``ros2 launch evorbc_bringup sim.launch.py`` uses too, so both
 bring up the same graph.
 """
 
@@ -22,7 +22,6 @@ from pathlib import Path
 
 from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorError
-from evorbc_ros.cli_support import OneLineParser, check_output_file, integer_in, report_unexpected
 from evorbc_ros.config import ConfigError
 from evorbc_ros.defaults import (
     PAPER_WITH_FILE,
@@ -35,6 +34,7 @@ from evorbc_ros.repertoire import RepertoireError
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
 from sim_bridge.bridge_node import SimBridgeNode, episode_verdict
+from sim_bridge.cli_support import OneLineParser, check_output_file, integer_in, report_unexpected
 from sim_bridge.graph import NodeSpec, exit_ends_graph, shipped_arbitrator, sim_graph
 from sim_bridge.maze import Maze, load_named_maze, maze_names
 
@@ -104,11 +104,12 @@ def parse_args(argv=None) -> argparse.Namespace:
 def node_command(
     module: str, params: dict, param_file: Path | None = None, namespace: str = ""
 ) -> list[str]:
-    """``python -m module --ros-args [--params-file F] [-r __ns:=/NS] -p k:=v ...``.
+    """``python -P -m module --ros-args [--params-file F] [-r __ns:=/NS] -p k:=v ...``.
 
     Empty values are left out; ``-p`` overrides win over the file.
     """
-    cmd = [sys.executable, "-m", module, "--ros-args"]
+    # -P: never import from the current folder (a checkout of the sources; design.md s. 10).
+    cmd = [sys.executable, "-P", "-m", module, "--ros-args"]
     if param_file is not None:
         cmd += ["--params-file", str(param_file)]
     if namespace:

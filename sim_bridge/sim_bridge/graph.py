@@ -1,7 +1,7 @@
 """The simulated graph as data: which nodes, with which parameters, for which robot.
 
 One description serves both ways of bringing the graph up: ``evorbc-sim``
-(:mod:`sim_bridge.bringup`, the nodes as plain processes) and ``ros2 launch evorbc_ros
+(:mod:`sim_bridge.bringup`, the nodes as plain processes) and ``ros2 launch evorbc_bringup
 sim.launch.py`` (a thin wrapper over :func:`graph_from_arguments`). It imports neither
 rclpy nor ``launch``, so the launch logic is tested wherever the project's tests run
 (docs/design.md section 10).
@@ -38,7 +38,7 @@ class Argument:
     description: str
 
 
-#: The arguments of ``sim.launch.py`` (``ros2 launch evorbc_ros sim.launch.py --show-args``).
+#: The arguments of ``sim.launch.py`` (``ros2 launch evorbc_bringup sim.launch.py --show-args``).
 ARGUMENTS = (
     Argument(
         "robot",

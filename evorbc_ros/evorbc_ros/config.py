@@ -157,26 +157,10 @@ def setting(
 
 
 def config_dir() -> Path:
-    """Folder holding the shipped settings files (``config/`` of the project).
+    """Folder holding the shipped settings files (the project's ``config/``).
 
-    Looked up, in order: ``$EVORBC_CONFIG_DIR``; the source tree next to this package (a
-    checkout or editable install); ``<prefix>/share/evorbc_ros/config`` of the prefix this
-    package is installed in (``<prefix>/lib/pythonX.Y/site-packages/evorbc_ros``); the same
-    under ``sys.prefix``.
+    They are package data of :mod:`evorbc_ros` (``evorbc_ros/settings``; in a checkout a
+    link to ``config/``), so an editable install, a wheel and a colcon install all find them
+    the same way, beside this module (docs/design.md section 10).
     """
-    env = os.environ.get("EVORBC_CONFIG_DIR")
-    if env:
-        return Path(env)
-    here = Path(__file__).resolve()
-    root = here.parents[1]
-    # A checkout or editable install: the project's own config/ beside its pyproject.toml.
-    if (root / "pyproject.toml").is_file() and (root / "config" / "sensors").is_dir():
-        return root / "config"
-    candidates = (
-        [here.parents[4] / "share" / "evorbc_ros" / "config"] if len(here.parents) > 4 else []
-    )
-    candidates.append(Path(sys.prefix) / "share" / "evorbc_ros" / "config")
-    for candidate in candidates:
-        if candidate.is_dir():
-            return candidate
-    return candidates[0]
+    return (Path(__file__).parent / "settings").resolve()
