@@ -61,13 +61,19 @@ def random_inputs(layout, rng, k: int) -> tuple[np.ndarray, np.ndarray]:
     return rng.uniform(0, 1, n_rf), np.array(goal)
 
 
-def arbitrator_latency(cycles: int = 2000) -> tuple[list[float], list[float]]:
-    """Seconds from the completing input to the primitive, and of the pure choice."""
+def arbitrator_latency(
+    cycles: int = 2000, parameters: dict | None = None
+) -> tuple[list[float], list[float], list[float]]:
+    """Seconds from the completing input to the primitive, of the pure choice, and inside the
+    arbitrator's callback for the completing input (``parameters``: the node's overrides)."""
+    from rclpy.parameter import Parameter
+
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "OFF"
     context = rclpy.Context()
     rclpy.init(context=context)
     executor = SingleThreadedExecutor(context=context)
-    node = ArbitratorNode(context=context)
+    overrides = [Parameter(k, value=v) for k, v in (parameters or {}).items()]
+    node = ArbitratorNode(context=context, parameter_overrides=overrides)
     probe = Node("probe", context=context)
     executor.add_node(node)
     executor.add_node(probe)
@@ -116,14 +122,19 @@ def arbitrator_latency(cycles: int = 2000) -> tuple[list[float], list[float]]:
     return latencies, pure, callback
 
 
-def graph_run(maze: str, mode: str, episode_time: float, domain: int) -> dict:
-    """One run of the five processes; the bridge's result plus CPU seconds per node."""
+def graph_run(
+    maze: str, mode: str, episode_time: float, domain: int, parameters: dict | None = None
+) -> dict:
+    """One run of the five processes; the bridge's result plus CPU seconds per node.
+
+    ``parameters``: node name -> more parameters for it.
+    """
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST", ROS_DOMAIN_ID=str(domain))
     with tempfile.TemporaryDirectory() as tmp:
         result = Path(tmp) / "result.json"
         procs = {
             name: subprocess.Popen(
-                node_command(module, {"use_sim_time": True}),
+                node_command(module, {"use_sim_time": True, **(parameters or {}).get(name, {})}),
                 env=env,
                 stdout=subprocess.DEVNULL,
                 stderr=subprocess.DEVNULL,

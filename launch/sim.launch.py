@@ -6,16 +6,33 @@
 
 Which nodes run, with which parameters, for which robot, comes from
 :mod:`sim_bridge.graph`, shared with ``evorbc-sim`` and tested without ``launch``; this
-file only turns it into launch actions. The whole graph shuts down when the bridge exits
-(the episode is over, or it could not start) and when any other node fails.
+file only turns it into launch actions. The lifecycle nodes (arbitrator, executor) start
+unconfigured and this file drives them: configure, then activate once configured. The
+whole graph shuts down when the bridge exits (the episode is over), and the launch fails
+(a non-zero status) when a node cannot start, fails to configure, or dies
+(docs/design.md section 9).
 """
 
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, OpaqueFunction, Shutdown
+from launch.actions import (
+    DeclareLaunchArgument,
+    EmitEvent,
+    OpaqueFunction,
+    RegisterEventHandler,
+    Shutdown,
+)
+from launch.events import matches_action
 from launch.substitutions import LaunchConfiguration
-from launch_ros.actions import Node
+from launch_ros.actions import LifecycleNode, Node
+from launch_ros.event_handlers import OnStateTransition
+from launch_ros.events.lifecycle import ChangeState
+from lifecycle_msgs.msg import Transition
 
 from sim_bridge.graph import ARGUMENTS, exit_ends_graph, graph_from_arguments
+
+
+class GraphFailed(RuntimeError):
+    """A node of the graph was refused or died: ``ros2 launch`` ends with status 1."""
 
 
 def generate_launch_description():
@@ -32,25 +49,66 @@ def generate_launch_description():
 
 
 def _nodes(context):
-    """One launch_ros Node per node of the graph."""
+    """One launch_ros node per node of the graph, and the lifecycle nodes' transitions."""
     graph = graph_from_arguments(
         {a.name: LaunchConfiguration(a.name).perform(context) for a in ARGUMENTS}
     )
-    return [
-        Node(
+    actions = []
+    for spec in graph.nodes:
+        kind = LifecycleNode if spec.managed else Node
+        params = {**spec.parameters, "autostart": False} if spec.managed else spec.parameters
+        node = kind(
             package=spec.package,
             executable=spec.name,
             name=spec.name,
             namespace=graph.namespace,
             output="screen",
-            parameters=[str(spec.param_file), spec.parameters],
-            on_exit=lambda event, _context, spec=spec: _on_exit(spec, event.returncode),
+            parameters=[str(spec.param_file), params],
+            on_exit=lambda event, context, spec=spec: _on_exit(spec, event.returncode, context),
         )
-        for spec in graph.nodes
+        actions.append(node)
+        if spec.managed:
+            actions += _drive(node, spec.name)
+    return actions
+
+
+def _drive(node, name):
+    """Configure ``node`` now; activate it once configured; fail the launch if it cannot."""
+
+    def change(transition):
+        return EmitEvent(
+            event=ChangeState(lifecycle_node_matcher=matches_action(node), transition_id=transition)
+        )
+
+    def refused(context):
+        raise GraphFailed(f"{name} could not be configured (its line above says why)")
+
+    return [
+        RegisterEventHandler(
+            OnStateTransition(
+                target_lifecycle_node=node,
+                start_state="configuring",
+                goal_state="inactive",
+                entities=[change(Transition.TRANSITION_ACTIVATE)],
+            )
+        ),
+        RegisterEventHandler(
+            OnStateTransition(
+                target_lifecycle_node=node,
+                start_state="configuring",
+                goal_state="unconfigured",
+                entities=[OpaqueFunction(function=refused)],
+            )
+        ),
+        change(Transition.TRANSITION_CONFIGURE),
     ]
 
 
-def _on_exit(spec, returncode):
-    """Shut the whole graph down if this exit leaves it useless."""
+def _on_exit(spec, returncode, context):
+    """Shut the graph down when this exit leaves it useless; fail if the node failed."""
     reason = exit_ends_graph(spec, returncode)
-    return [Shutdown(reason=reason)] if reason else None
+    if not reason or getattr(context, "is_shutdown", False):
+        return None
+    if returncode != 0:
+        raise GraphFailed(reason)
+    return [Shutdown(reason=reason)]

@@ -65,6 +65,18 @@ class Ros:
         """Wait until ``publisher`` has ``count`` subscribers."""
         assert self.spin_until(lambda: publisher.get_subscription_count() >= count, timeout)
 
+    def arbitrator_inputs(self):
+        """Connected publishers of the arbitrator's inputs: rangefinders, goal sectors."""
+        from std_msgs.msg import Float64MultiArray
+
+        pubs = [
+            self.publisher(Float64MultiArray, t)
+            for t in ("evorbc/rangefinders", "evorbc/goal_sectors")
+        ]
+        for p in pubs:
+            self.connected(p)
+        return pubs
+
     def executor_inputs(self):
         """Connected publishers of the executor's inputs: primitive, rangefinders, goal."""
         from std_msgs.msg import Float64MultiArray

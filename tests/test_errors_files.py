@@ -321,7 +321,7 @@ def test_evorbc_sim_refuses_bad_options_before_starting_a_node(
     monkeypatch.chdir(tmp_path)
     (tmp_path / "f.txt").write_text("not a folder")
     code, err = run_sim(capsys, "--quiet", *argv)
-    assert code == 1 and len(err) == 1
+    assert code == 2 and len(err) == 1
     assert err[0].startswith(f"evorbc-sim: error: {message}")
 
 
@@ -343,11 +343,11 @@ def test_evorbc_sim_files_are_refused_without_suggesting_an_option_it_lacks(
 ):
     arb = write(tmp_path, "a.json", ARB, lambda d: d["repertoire"].update(fingerprint="0" * 64))
     code, err = run_sim(capsys, "--arbitrator", str(arb))
-    assert code == 1 and len(err) == 1
+    assert code == 2 and len(err) == 1
     assert err[0].endswith("the arbitrator was evolved with 000000000000")
     bad = write(tmp_path, "cp.json", ARB, lambda d: d.update(control_period="abc"))
     code, err = run_sim(capsys, "--arbitrator", str(bad))
-    assert code == 1 and err == [
+    assert code == 2 and err == [
         f"evorbc-sim: error: {bad}: control_period must be a number of seconds > 0, got 'abc'"
     ]
 

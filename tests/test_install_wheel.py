@@ -11,6 +11,8 @@ first and installs it.)
 from __future__ import annotations
 
 import os
+import signal
+import subprocess
 import sys
 import tarfile
 import zipfile
@@ -25,6 +27,7 @@ from install_helpers import (
     reached,
     run,
     start_and_stop,
+    wait_for_node,
 )
 
 pytestmark = pytest.mark.slow
@@ -80,7 +83,7 @@ def test_the_wheel_holds_the_settings_controllers_and_ros_files(wheel):
     data = "evorbc-0.1.0.data/data/"
     for path in (
         "evorbc_ros/settings/robots/4ws.yaml",
-        "evorbc_ros/settings/ros/evorbc_nodes.yaml",
+        "evorbc_ros/settings/ros/arbitrator.yaml",
         "evorbc_ros/settings/mazes/obstacle.yaml",
         "evorbc_ros/settings/neat/4ws.ini",
         "evorbc_ros/data/4ws-5.arbitrator.json",
@@ -165,9 +168,13 @@ def test_evorbc_sim_drives_the_shipped_controller_to_the_target(venv, tmp_path):
     reached(out)
 
 
-def test_ros2_run_and_ros2_launch_from_the_wheel(venv, tmp_path):
+def needs_ros2(venv):
     if not (venv / "bin" / "ros2").exists():
         pytest.skip(f"needs the ros2 CLI and launch: set {ROS2_WHEELS}")
+
+
+def test_ros2_run_and_ros2_launch_from_the_wheel(venv, tmp_path):
+    needs_ros2(venv)
     env = venv_env(venv, 196)
     done = run(
         ["ros2", "run", "evorbc_ros", "arbitrator", "--ros-args", "-p", NODES[2][2]],
@@ -178,3 +185,51 @@ def test_ros2_run_and_ros2_launch_from_the_wheel(venv, tmp_path):
     assert_fatal_line(done, "arbitrator", NODES[2][3])
     out = run(["ros2", "launch", "evorbc_bringup", "sim.launch.py", "maze:=gaps"], env, tmp_path)
     assert "reached the target" in out.stdout + out.stderr
+    # A refused node fails the launch, naming why.
+    shipped = next((venv / "lib").glob("python3*/site-packages/evorbc_ros/data"))
+    other = f"arbitrator:={shipped / '4ws-5.arbitrator.json'}"
+    done = run(
+        ["ros2", "launch", "evorbc_bringup", "sim.launch.py", "robot:=4ws-3", other],
+        env,
+        tmp_path,
+        check=False,
+    )
+    out = done.stdout + done.stderr
+    assert done.returncode == 1, out
+    assert "cannot configure: " in out and "but parameter robot is 4ws-3" in out
+    assert "reached the target" not in out
+
+
+def test_ros2_lifecycle_param_and_diagnostics_from_the_wheel(venv, tmp_path):
+    needs_ros2(venv)
+    env = venv_env(venv, 193)
+
+    def ros2(*args):
+        return run(["ros2", *args], env, tmp_path, timeout=120, check=False)
+
+    node = subprocess.Popen(
+        ["ros2", "run", "evorbc_ros", "arbitrator"],
+        env=env,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        wait_for_node("arbitrator", 193, node)
+        assert ros2("lifecycle", "get", "/arbitrator").stdout.strip() == "active [3]"
+        described = ros2("param", "describe", "/arbitrator", "diagnostics_period").stdout
+        assert "Min value: 0.1" in described and "Max value: 60.0" in described
+        shipped = next((venv / "lib").glob("python3*/site-packages/evorbc_ros/settings"))
+        loaded = ros2("param", "load", "/arbitrator", str(shipped / "ros" / "arbitrator.yaml"))
+        assert loaded.returncode == 0 and "failed" not in loaded.stdout + loaded.stderr
+        assert "Set parameter robot successful" in loaded.stdout
+        assert ros2("lifecycle", "set", "/arbitrator", "deactivate").returncode == 0
+        assert ros2("lifecycle", "get", "/arbitrator").stdout.strip() == "inactive [2]"
+        echo = ros2("topic", "echo", "--once", "/diagnostics")
+        assert "name: /arbitrator" in echo.stdout and "value: inactive" in echo.stdout
+    finally:
+        os.killpg(node.pid, signal.SIGINT)
+        out = node.communicate(timeout=30)[0]
+    assert node.returncode == 0 and "Traceback" not in out, out

@@ -135,7 +135,7 @@ def test_evorbc_sim_and_the_launch_file_run_the_paper_protocol_controller(mine, 
     assert controller.arbitrator_path == str(mine["paper"])
     controller, _, _ = bringup.prepare(bringup.parse_args(["--robot", "4ws-5"]))
     assert controller.arbitrator_path == str(mine["default"])
-    assert bringup.main(["--paper", "--arbitrator", str(mine["paper"])]) == 1
+    assert bringup.main(["--paper", "--arbitrator", str(mine["paper"])]) == 2
     assert capsys.readouterr().err.strip().splitlines() == [f"evorbc-sim: error: {BOTH}"]
 
     assert arbitrator(sim_graph(robot="4ws-5", paper=True)) == str(mine["paper"])

@@ -95,7 +95,7 @@ def test_evorbc_sim_refuses_an_a1_repertoire_of_another_design(tmp_path, control
     other = {**simulation, "physics": {**simulation["physics"], "rate_hz": 50.0}}
     path = tmp_path / "other.json"
     dataclasses.replace(rep, algorithm={"simulation": other}).save(path)
-    assert main(["--robot", "a1", "--arbitrator", str(arb_path), "--repertoire", str(path)]) == 1
+    assert main(["--robot", "a1", "--arbitrator", str(arb_path), "--repertoire", str(path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [
         f"evorbc-sim: error: {path}: was evolved for a different robot "

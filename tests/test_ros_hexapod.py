@@ -195,7 +195,7 @@ def test_evorbc_sim_refuses_a_start_inside_the_legs_reach_before_starting_the_gr
     argv = ["--arbitrator", str(arb_path), "--repertoire", str(rep_path), "--quiet"]
     # The obstacle maze's nominal start is 0.09 m from a wall; the legs reach 0.31 m. No
     # --start was given: the robot does not fit the maze.
-    assert main([*argv, "--maze", "obstacle", "--result", str(old), "--plot", ""]) == 1
+    assert main([*argv, "--maze", "obstacle", "--result", str(old), "--plot", ""]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [
         "evorbc-sim: error: robot hexapod does not fit maze obstacle: at the maze's start "
@@ -203,7 +203,7 @@ def test_evorbc_sim_refuses_a_start_inside_the_legs_reach_before_starting_the_gr
         "its maze is hexapod"
     ]
     # A start the user gives is what is blamed.
-    assert main([*argv, "--maze", "obstacle", "--start=-5.46,0.65,0", "--plot", ""]) == 1
+    assert main([*argv, "--maze", "obstacle", "--start=-5.46,0.65,0", "--plot", ""]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("evorbc-sim: error: --start: (-5.46, 0.65) m is")
     assert "m from a wall of maze obstacle" in err[0]
@@ -222,7 +222,7 @@ def test_evorbc_sim_refuses_a_repertoire_of_another_design(tmp_path, controller,
     other = {**simulation, "physics": {**simulation["physics"], "rate_hz": 60.0}}
     path = tmp_path / "other.json"
     dataclasses.replace(rep, algorithm={"simulation": other}).save(path)
-    assert main(["--arbitrator", str(arb_path), "--repertoire", str(path)]) == 1
+    assert main(["--arbitrator", str(arb_path), "--repertoire", str(path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [
         f"evorbc-sim: error: {path}: was evolved for a different robot "
@@ -234,7 +234,7 @@ def test_evorbc_sim_refuses_an_arbitrator_for_another_robot(capsys):
     from evorbc_ros.defaults import default_arbitrator
     from sim_bridge.bringup import main
 
-    assert main(["--robot", "hexapod", "--arbitrator", str(default_arbitrator())]) == 1
+    assert main(["--robot", "hexapod", "--arbitrator", str(default_arbitrator())]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [
         f"evorbc-sim: error: {default_arbitrator()}: is for robot 4ws-5, not --robot hexapod"
@@ -253,6 +253,6 @@ def test_evorbc_sim_refuses_an_arbitrator_evolved_with_another_laser(tmp_path, c
     layout["rangefinders"] = {**layout["rangefinders"], "range": 4.0}  # a longer-range laser
     path = tmp_path / "other-laser.json"
     dataclasses.replace(arb, sensors=SensorLayout.from_dict(layout)).save(path)
-    assert main(["--arbitrator", str(path), "--repertoire", str(rep_path)]) == 1
+    assert main(["--arbitrator", str(path), "--repertoire", str(rep_path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(f"evorbc-sim: error: {path}: its sensor layout")

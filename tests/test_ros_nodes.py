@@ -208,11 +208,13 @@ def test_executor_stops_when_the_arbitrator_falls_silent(ros):
     ("cls", "params", "needle"),
     [
         (PrimitiveExecutorNode, {"robot": "tank"}, "parameter robot must be one of"),
-        (PrimitiveExecutorNode, {"wheel_radius": -1.0}, "wheel_radius must be a positive"),
+        (PrimitiveExecutorNode, {"wheel_radius": -1.0}, "wheel_radius must be between 0.0 and"),
         (LaserSensorNode, {"laser_yaw": math.nan}, "laser_yaw must be a finite"),
         (LaserSensorNode, {"sensor_layout": "/nonexistent.yaml"}, "no such settings file"),
         (RadarSensorNode, {"goal_type": "polygon"}, "goal_type must be"),
-        (PrimitiveExecutorNode, {"stale_timeout": "soon"}, "stale_timeout must be a positive"),
+        (PrimitiveExecutorNode, {"stale_timeout": "soon"}, "stale_timeout must be a finite"),
+        (PrimitiveExecutorNode, {"period": 100.0}, "period must be between 0.001 and 10.0"),
+        (PrimitiveExecutorNode, {"watched_inputs": ["scan"]}, "watched_inputs must be made of"),
         (PrimitiveExecutorNode, {"robot": 5}, "parameter robot must be a string"),
     ],
 )

@@ -1,134 +1,240 @@
-"""Node parameters as ROS users expect them: the shipped parameter files apply under any
-namespace, ``ros2 param set`` never claims a success that changes nothing, and the one
-live parameter changes what the node does."""
+"""Node parameters as ROS users expect them (docs/design.md section 9, "Parameters").
+
+* each node's shipped parameter file (``config/ros/<node>.yaml``, key ``/**``) applies under
+  any namespace, and holds only parameters of its table, with valid values;
+* every numeric parameter has its range in its descriptor (``ros2 param describe``);
+* a parameter read once refuses another value with the reason, but takes the value it has,
+  so ``ros2 param load`` of the shipped file works on a running node; a lifecycle node takes
+  any valid value while unconfigured; the live ``wheel_radius`` changes what the node does;
+* the topic-name parameters of earlier versions are refused, naming the remapping.
+"""
 
 import numpy as np
 import pytest
-import rclpy
 import yaml
-from rclpy.node import Node
+from rclpy.lifecycle import TransitionCallbackReturn
 from rclpy.parameter import Parameter
 from ros_helpers import ros_with_args
 from std_msgs.msg import Float64MultiArray
 
 from evorbc_ros.config import config_dir
+from evorbc_ros.node_parameters import PARAMETERS, REMOVED
 from evorbc_ros.nodes.arbitrator import ArbitratorNode
-from evorbc_ros.nodes.common import vector_message
+from evorbc_ros.nodes.common import StartupError, vector_message
 from evorbc_ros.nodes.laser_sensor import LaserSensorNode
 from evorbc_ros.nodes.primitive_executor import PrimitiveExecutorNode
 from evorbc_ros.nodes.radar_sensor import RadarSensorNode
+from sim_bridge import bridge_parameters
 
-NODES_FILE = config_dir() / "ros" / "evorbc_nodes.yaml"
-BRIDGE_FILE = config_dir() / "ros" / "sim_bridge.yaml"
-#: rclpy's own parameters: use_sim_time is applied live by rclpy itself.
+NODES = {
+    "laser_sensor": LaserSensorNode,
+    "radar_sensor": RadarSensorNode,
+    "arbitrator": ArbitratorNode,
+    "primitive_executor": PrimitiveExecutorNode,
+}
+TABLES = {**PARAMETERS, "sim_bridge": bridge_parameters.PARAMETERS}
+#: rclpy's own parameters.
 RCLPY_PARAMETERS = {"use_sim_time", "start_type_description_service"}
 
 
-def file_section(path, node):
-    """The parameters a file gives ``node`` (under the any-namespace key ``/**``)."""
-    return yaml.safe_load(path.read_text())["/**"][node]["ros__parameters"]
+def param_file(node):
+    return config_dir() / "ros" / f"{node}.yaml"
+
+
+def file_values(node):
+    """The parameters a node's file gives (under the any-node key ``/**``)."""
+    return yaml.safe_load(param_file(node).read_text())["/**"]["ros__parameters"]
+
+
+@pytest.mark.parametrize("node", sorted(TABLES))
+def test_each_shipped_file_holds_valid_values_of_its_nodes_table(node):
+    specs = {s.name: s for s in TABLES[node]}
+    values = file_values(node)
+    assert set(values) <= set(specs), set(values) - set(specs)
+    for name, value in values.items():
+        assert specs[name].problem(value) == "", name
+    # The file shows every parameter a user may want to change (all but the bridge's
+    # readiness lists, which evorbc-sim and the launch file fill in).
+    assert set(specs) - set(values) <= {"wait_for_subscribers", "wait_for_publishers"}
 
 
 @pytest.mark.parametrize("namespace", ["", "robot1", "fleet/robot2"])
-@pytest.mark.parametrize(
-    ("name", "cls", "robot"),
-    [
-        ("laser_sensor", LaserSensorNode, None),
-        ("radar_sensor", RadarSensorNode, None),
-        ("arbitrator", ArbitratorNode, None),
-        ("primitive_executor", PrimitiveExecutorNode, None),
-        ("primitive_executor", PrimitiveExecutorNode, "hexapod"),
-    ],
-)
-def test_the_shipped_parameter_file_applies_under_any_namespace(
-    monkeypatch, name, cls, robot, namespace
-):
+@pytest.mark.parametrize("name", sorted(NODES))
+def test_the_shipped_file_applies_under_any_namespace(monkeypatch, name, namespace):
     monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")
-    params = file_section(NODES_FILE, name)
-    with ros_with_args("--params-file", str(NODES_FILE)) as ros:
-        extra = {"robot": robot} if robot else {}
-        node = ros.make(cls, namespace=namespace, **extra)
-        # rcl matched the file's section to this node, wherever it runs ...
-        assert set(params) <= set(node._parameter_overrides)
-        # ... and the node declares every key it sets, with the file's value.
-        assert not {k for k in params if not node.has_parameter(k)}
-        for key, value in {**params, **extra}.items():
-            assert node.get_parameter(key).value == value
+    values = file_values(name)
+    with ros_with_args("--params-file", str(param_file(name))) as ros:
+        node = ros.make(NODES[name], namespace=namespace)
+        for key, value in values.items():
+            got = node.get_parameter(key).value
+            assert (list(got) if isinstance(got, (list, tuple)) else got) == value, key
 
 
 def test_a_changed_value_in_the_file_reaches_a_namespaced_node(monkeypatch, tmp_path):
     monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")
-    data = yaml.safe_load(NODES_FILE.read_text())
-    data["/**"]["primitive_executor"]["ros__parameters"]["wheel_radius"] = 0.05
-    data["/**"]["laser_sensor"]["ros__parameters"]["laser_x"] = 0.125
+    data = yaml.safe_load(param_file("primitive_executor").read_text())
+    data["/**"]["ros__parameters"]["wheel_radius"] = 0.05
     edited = tmp_path / "my_robot.yaml"
     edited.write_text(yaml.safe_dump(data))
     with ros_with_args("--params-file", str(edited)) as ros:
         executor = ros.make(PrimitiveExecutorNode, namespace="robot1")
-        laser = ros.make(LaserSensorNode, namespace="robot1")
         assert executor.wheel_radius == 0.05
-        assert laser.get_parameter("laser_x").value == 0.125
 
 
-@pytest.mark.parametrize("namespace", ["", "robot1"])
-def test_the_bridge_parameter_file_applies_under_any_namespace(monkeypatch, namespace):
-    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")
-    params = file_section(BRIDGE_FILE, "sim_bridge")
-    context = rclpy.Context()
-    rclpy.init(context=context, args=["--ros-args", "--params-file", str(BRIDGE_FILE)])
-    try:
-        node = Node("sim_bridge", namespace=namespace, context=context)
-        overrides = {k: p.value for k, p in node._parameter_overrides.items()}
-        assert {k: overrides.get(k) for k in params} == params
-        node.destroy_node()
-    finally:
-        rclpy.try_shutdown(context=context)
+def describe(node):
+    names = sorted(set(node.list_parameters([], 1).names) - RCLPY_PARAMETERS)
+    return dict(zip(names, node.describe_parameters(names), strict=True))
 
 
-def changed(value):
-    """Another value of the same type (what a user might try with ros2 param set)."""
-    if isinstance(value, bool):
-        return not value
-    if isinstance(value, (int, float)):
-        return value * 2 + 1
-    if isinstance(value, str):
-        return value + "_other"
-    return [*value, "other"]
+def assert_described(node, table):
+    described = describe(node)
+    assert set(described) == {s.name for s in table}
+    for spec in table:
+        d = described[spec.name]
+        assert d.description == spec.description
+        if spec.kind is float:
+            (r,) = d.floating_point_range
+            assert (r.from_value, r.to_value) == (spec.minimum, spec.maximum), spec.name
+        elif spec.kind is int:
+            (r,) = d.integer_range
+            assert (r.from_value, r.to_value) == (spec.minimum, spec.maximum), spec.name
+        when = "applied live" if spec.live else "read at"
+        assert d.additional_constraints.startswith(when), spec.name
 
 
-def assert_read_only_except(node, live):
-    names = set(node.list_parameters([], 1).names) - RCLPY_PARAMETERS
-    assert live <= names
-    for name in sorted(names - live):
-        before = node.get_parameter(name).value
-        result = node.set_parameters([Parameter(name, value=changed(before))])[0]
-        assert not result.successful, f"{name} claims it was set"
-        assert "read-only" in result.reason
-        assert node.get_parameter(name).value == before
+@pytest.mark.parametrize("name", sorted(NODES))
+def test_every_parameter_is_described_with_its_range(ros, name):
+    assert_described(ros.make(NODES[name]), PARAMETERS[name])
 
 
-@pytest.mark.parametrize(
-    ("cls", "params", "live"),
-    [
-        (LaserSensorNode, {}, set()),
-        (RadarSensorNode, {}, set()),
-        (ArbitratorNode, {"robot": "4ws-5"}, set()),
-        (PrimitiveExecutorNode, {}, {"wheel_radius"}),
-        (PrimitiveExecutorNode, {"robot": "hexapod"}, {"wheel_radius"}),
-    ],
-)
-def test_parameters_read_at_start_up_are_read_only(ros, cls, params, live):
-    assert_read_only_except(ros.make(cls, **params), live)
-
-
-def test_the_bridge_parameters_are_read_only(ros):
+def test_the_bridge_describes_every_parameter_with_its_range(ros):
     from sim_bridge.bridge_node import SimBridgeNode
 
     node = ros.make(SimBridgeNode)
     try:
-        assert_read_only_except(node, set())
+        assert_described(node, bridge_parameters.PARAMETERS)
     finally:
         node.world.close()
+
+
+def test_every_numeric_parameter_has_a_range():
+    for table in TABLES.values():
+        for spec in table:
+            if spec.kind in (int, float):
+                assert spec.minimum is not None and spec.maximum is not None, spec.name
+
+
+def changed(value, choices=()):
+    """Another valid value (what a user might try with ros2 param set)."""
+    if choices and isinstance(value, str):
+        return next(c for c in choices if c != value)
+    if isinstance(value, bool):
+        return not value
+    if isinstance(value, float):
+        return value / 2 + 0.001
+    if isinstance(value, int):
+        return value + 1
+    if isinstance(value, str):
+        return value + "_other"
+    return list(value[:1]) if value else ["other"]
+
+
+def assert_read_once(node, table, when):
+    """Another value is refused with the reason; the value it has is taken."""
+    for spec in table:
+        before = node.get_parameter(spec.name).value
+        other = changed(before, spec.choices)
+        result = node.set_parameters([Parameter(spec.name, value=other)])[0]
+        if spec.live:
+            continue
+        assert not result.successful, f"{spec.name} claims it was set"
+        assert result.reason.startswith(f"parameter {spec.name} is read at "), result.reason
+        if not spec.at_start:
+            assert f"is read {when}" in result.reason
+        assert node.get_parameter(spec.name).value == before
+    # What ros2 param load of the node's own values does: every one succeeds.
+    current = [node.get_parameter(s.name) for s in table if not s.live]
+    assert all(r.successful for r in node.set_parameters(current))
+
+
+@pytest.mark.parametrize(
+    ("name", "params"),
+    [
+        ("laser_sensor", {}),
+        ("radar_sensor", {}),
+        ("arbitrator", {"robot": "4ws-5"}),
+        ("primitive_executor", {}),
+        ("primitive_executor", {"robot": "hexapod"}),
+    ],
+)
+def test_parameters_read_once_refuse_a_change_and_take_their_own_value(ros, name, params):
+    when = "at configure" if name in ("arbitrator", "primitive_executor") else "at start-up"
+    assert_read_once(ros.make(NODES[name], **params), PARAMETERS[name], when)
+
+
+def test_the_bridge_parameters_refuse_a_change(ros):
+    from sim_bridge.bridge_node import SimBridgeNode
+
+    node = ros.make(SimBridgeNode)
+    try:
+        assert_read_once(node, bridge_parameters.PARAMETERS, "at start-up")
+    finally:
+        node.world.close()
+
+
+def test_a_lifecycle_node_takes_any_valid_value_while_unconfigured(ros, tmp_path):
+    node = ros.make(ArbitratorNode, autostart=False)
+    assert node.state == "unconfigured"
+    ok = node.set_parameters([Parameter("robot", value="hexapod")])[0]
+    assert ok.successful
+    bad = node.set_parameters([Parameter("diagnostics_period", value=1000.0)])[0]
+    assert not bad.successful and "out of range" in bad.reason  # rclpy checks the range
+    assert node.trigger_configure() == TransitionCallbackReturn.SUCCESS
+    assert node.controller.spec.robot == "hexapod"  # read at configure
+    refused = node.set_parameters([Parameter("robot", value="4ws-5")])[0]
+    assert not refused.successful
+    assert refused.reason == (
+        "parameter robot is read at configure: deactivate, clean up, set it and configure again"
+    )
+
+
+def test_a_whole_number_for_a_float_parameter_is_its_value(ros):
+    node = ros.make(PrimitiveExecutorNode)  # trajectory_rate is 0.0
+    assert node.set_parameters([Parameter("trajectory_rate", value=0)])[0].successful
+    assert not node.set_parameters([Parameter("trajectory_rate", value=1)])[0].successful
+    assert node.parameters()["trajectory_rate"] == 0.0
+
+
+@pytest.mark.parametrize(
+    ("name", "removed"), [(n, old) for n, table in REMOVED.items() for old in table]
+)
+def test_a_removed_topic_parameter_is_refused_naming_the_remap(monkeypatch, name, removed):
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")
+    with ros_with_args("-p", f"{removed}:=/my/topic") as ros, pytest.raises(StartupError) as info:
+        ros.make(NODES[name])
+    topic = REMOVED[name][removed].split(" ")[0]
+    assert str(info.value).startswith(
+        f"parameter {removed} was removed: topics have fixed names now; remap instead: "
+        f"--ros-args -r {topic}:=<your topic>"
+    )
+
+
+@pytest.mark.parametrize("removed", sorted(bridge_parameters.REMOVED))
+def test_the_bridge_refuses_a_removed_topic_parameter(monkeypatch, removed):
+    from sim_bridge.bridge_node import SimBridgeNode
+
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")
+    with ros_with_args("-p", f"{removed}:=x") as ros, pytest.raises(StartupError) as info:
+        ros.make(SimBridgeNode)
+    assert f"-r {bridge_parameters.REMOVED[removed]}:=<your topic>" in str(info.value)
+
+
+def test_the_topics_are_remapped_instead(monkeypatch):
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")
+    with ros_with_args("-r", "scan:=/front/scan", "-r", "evorbc/rangefinders:=rf") as ros:
+        node = ros.make(LaserSensorNode)
+        assert node.sub.topic_name == "/front/scan"
+        assert node.pub.topic_name == "/rf"
 
 
 def test_wheel_radius_is_applied_live_and_validated(ros):
@@ -149,10 +255,13 @@ def test_wheel_radius_is_applied_live_and_validated(ros):
     result = node.set_parameters([Parameter("wheel_radius", value=0.04)])[0]
     assert result.successful
     np.testing.assert_allclose(run_primitive(), [0.2 / 0.04] * 4)
-    for bad in (-1.0, 0.0, float("nan"), "big"):
+    for bad in (-1.0, float("nan"), "big", 11.0):
         result = node.set_parameters([Parameter("wheel_radius", value=bad)])[0]
         assert not result.successful
-        assert result.reason.startswith("parameter wheel_radius must be a positive number")
+        assert "wheel_radius" in result.reason
     assert node.get_parameter("wheel_radius").value == 0.04
     result = node.set_parameters([Parameter("wheel_radius", value=1)])[0]  # an int is a number
     assert result.successful and node.wheel_radius == 1.0
+    # 0 means the robot's own again.
+    assert node.set_parameters([Parameter("wheel_radius", value=0.0)])[0].successful
+    assert node.wheel_radius == 0.02

@@ -1,7 +1,8 @@
 """The simulated graph's description (sim_bridge.graph), shared by evorbc-sim and the
 launch file: which nodes, with which parameters, for which robot, and when the graph ends.
 The launch file is run against stand-ins for ``launch`` and ``launch_ros``, so this runs
-where ROS 2's launch is not installed; the real one is tried in test_ros_packaging."""
+where ROS 2's launch is not installed; the real one is tried in test_install_wheel and
+test_install_colcon where the ros2 CLI is installed."""
 
 import runpy
 import sys
@@ -17,12 +18,12 @@ from sim_bridge.graph import (
     ARGUMENTS,
     exit_ends_graph,
     graph_from_arguments,
+    param_file,
     sim_graph,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
-NODES_FILE = config_dir() / "ros" / "evorbc_nodes.yaml"
-BRIDGE_FILE = config_dir() / "ros" / "sim_bridge.yaml"
+NODES_FILE = config_dir() / "ros" / "arbitrator.yaml"
 
 
 def params(graph):
@@ -55,11 +56,11 @@ def test_the_default_graph_runs_the_shipped_4ws_5_controller_in_obstacle():
         },
     }
     assert {n.name: n.param_file for n in graph.nodes} == {
-        **dict.fromkeys(["laser_sensor", "radar_sensor", "arbitrator"], NODES_FILE),
-        "primitive_executor": NODES_FILE,
-        "sim_bridge": BRIDGE_FILE,
+        n.name: config_dir() / "ros" / f"{n.name}.yaml" for n in graph.nodes
     }
+    assert all(param_file(n.name).is_file() for n in graph.nodes)
     assert [n.name for n in graph.nodes if n.required] == ["sim_bridge"]
+    assert [n.name for n in graph.nodes if n.managed] == ["arbitrator", "primitive_executor"]
     assert {n.package for n in graph.nodes} == {"evorbc_ros", "sim_bridge"}
     assert graph.namespace == ""
 
@@ -157,16 +158,28 @@ def fake_launch(monkeypatch, values):
         def perform(self, context):
             return values.get(self.args[0], context[self.args[0]])
 
+    class Node(Recorded):
+        pass
+
+    class LifecycleNode(Node):
+        pass
+
     modules = {
         "launch": {"LaunchDescription": Recorded},
         "launch.actions": {
             "DeclareLaunchArgument": Recorded,
+            "EmitEvent": Recorded,
             "OpaqueFunction": Recorded,
+            "RegisterEventHandler": Recorded,
             "Shutdown": Recorded,
         },
+        "launch.events": {"matches_action": lambda action: ("matches", action)},
         "launch.substitutions": {"LaunchConfiguration": LaunchConfiguration},
         "launch_ros": {},
-        "launch_ros.actions": {"Node": Recorded},
+        "launch_ros.actions": {"Node": Node, "LifecycleNode": LifecycleNode},
+        "launch_ros.event_handlers": {"OnStateTransition": Recorded},
+        "launch_ros.events": {},
+        "launch_ros.events.lifecycle": {"ChangeState": Recorded},
     }
     for name, attrs in modules.items():
         module = types.ModuleType(name)
@@ -183,11 +196,12 @@ def launch_nodes(monkeypatch, **values):
     declared = [e for e in entities if "default_value" in e.kwargs]
     defaults = {e.args[0]: e.kwargs["default_value"] for e in declared}
     opaque = entities[-1].kwargs["function"]
-    return declared, opaque(defaults)
+    actions = opaque(defaults)
+    return declared, [a for a in actions if "executable" in a.kwargs], actions
 
 
 def test_the_launch_file_declares_every_argument_with_a_description(monkeypatch):
-    declared, _ = launch_nodes(monkeypatch)
+    declared, _, _ = launch_nodes(monkeypatch)
     assert [(e.args[0], e.kwargs["default_value"]) for e in declared] == [
         (a.name, a.default) for a in ARGUMENTS
     ]
@@ -196,27 +210,64 @@ def test_the_launch_file_declares_every_argument_with_a_description(monkeypatch)
 
 
 def test_the_launch_file_starts_the_shared_graph(monkeypatch):
-    _, nodes = launch_nodes(monkeypatch, robot="hexapod", namespace="robot1")
+    _, nodes, _ = launch_nodes(monkeypatch, robot="hexapod", namespace="robot1")
     graph = sim_graph(robot="hexapod", namespace="robot1")
     assert [n.kwargs["executable"] for n in nodes] == [n.name for n in graph.nodes]
     for node, spec in zip(nodes, graph.nodes, strict=True):
         assert node.kwargs["package"] == spec.package
         assert node.kwargs["namespace"] == "robot1"
-        assert node.kwargs["parameters"] == [str(spec.param_file), spec.parameters]
+        extra = {"autostart": False} if spec.managed else {}
+        assert node.kwargs["parameters"] == [str(spec.param_file), spec.parameters | extra]
+        assert type(node).__name__ == ("LifecycleNode" if spec.managed else "Node")
 
 
-def test_the_launch_file_shuts_the_graph_down_as_the_shared_rule_says(monkeypatch):
-    _, nodes = launch_nodes(monkeypatch)
+def test_the_launch_file_shuts_the_graph_down_and_fails_as_the_shared_rule_says(monkeypatch):
+    _, nodes, _ = launch_nodes(monkeypatch)
     on_exit = {n.kwargs["executable"]: n.kwargs["on_exit"] for n in nodes}
+    running = types.SimpleNamespace(is_shutdown=False)
 
-    def exited(name, code):
-        return on_exit[name](types.SimpleNamespace(returncode=code), None)
+    def exited(name, code, context=running):
+        return on_exit[name](types.SimpleNamespace(returncode=code), context)
 
     (shutdown,) = exited("sim_bridge", 0)
     assert shutdown.kwargs["reason"] == "sim_bridge exited (the episode is over)"
     assert exited("laser_sensor", 0) is None
-    (shutdown,) = exited("arbitrator", 2)
-    assert shutdown.kwargs["reason"].startswith("arbitrator failed (status 2)")
+    # A node refused or dead fails the launch (ros2 launch: status 1), naming it.
+    for name, code, reason in [
+        ("arbitrator", 2, "arbitrator failed (status 2)"),
+        ("laser_sensor", -9, "laser_sensor failed (status -9)"),
+        ("sim_bridge", 2, "sim_bridge exited (status 2)"),
+    ]:
+        with pytest.raises(RuntimeError, match=reason.replace("(", r"\(").replace(")", r"\)")):
+            exited(name, code)
+    # Once the launch is shutting down, exits are expected.
+    assert exited("arbitrator", -2, types.SimpleNamespace(is_shutdown=True)) is None
+
+
+def test_the_launch_file_configures_then_activates_the_lifecycle_nodes(monkeypatch):
+    from lifecycle_msgs.msg import Transition
+
+    _, nodes, actions = launch_nodes(monkeypatch)
+    managed = [n for n in nodes if type(n).__name__ == "LifecycleNode"]
+    assert [n.kwargs["name"] for n in managed] == ["arbitrator", "primitive_executor"]
+    for node in managed:
+        emitted = [
+            a.kwargs["event"].kwargs
+            for a in actions
+            if "event" in a.kwargs and a.kwargs["event"].kwargs["lifecycle_node_matcher"][1] is node
+        ]
+        assert [e["transition_id"] for e in emitted] == [Transition.TRANSITION_CONFIGURE]
+        handlers = [
+            a.args[0].kwargs
+            for a in actions
+            if a.args and a.args[0].kwargs.get("target_lifecycle_node") is node
+        ]
+        on = {(h["start_state"], h["goal_state"]): h["entities"] for h in handlers}
+        (activate,) = on["configuring", "inactive"]
+        assert activate.kwargs["event"].kwargs["transition_id"] == Transition.TRANSITION_ACTIVATE
+        (refused,) = on["configuring", "unconfigured"]
+        with pytest.raises(RuntimeError, match="could not be configured"):
+            refused.kwargs["function"](None)
 
 
 def test_evorbc_sim_starts_the_same_graph_with_the_parameter_files(monkeypatch):
@@ -288,7 +339,7 @@ def test_a_mistyped_robot_is_one_line(capsys):
 
 def test_a_robot_without_a_shipped_controller_says_how_to_make_one(capsys, no_graph):
     code, err = run_sim(capsys, "--robot", "2ws-2")
-    assert code == 1
+    assert code == 2
     assert err == [
         "evorbc-sim: error: no controller ships for robot 2ws-2 (only for 4ws-5, a1 and hexapod); "
         "make one with 'evorbc-evolve repertoire --robot 2ws-2 --seed 1 --out r.json' and "
@@ -299,7 +350,7 @@ def test_a_robot_without_a_shipped_controller_says_how_to_make_one(capsys, no_gr
 
 def test_a_robot_that_does_not_fit_the_maze_is_not_blamed_on_start(capsys, no_graph):
     code, err = run_sim(capsys, "--robot", "hexapod", "--maze", "zigzag")
-    assert code == 1 and len(err) == 1
+    assert code == 2 and len(err) == 1
     assert err[0].startswith("evorbc-sim: error: robot hexapod does not fit maze zigzag: ")
     assert "--start" not in err[0] and err[0].endswith("its maze is hexapod")
     code, err = run_sim(capsys, "--robot", "hexapod", "--maze", "zigzag", "--start", "random")

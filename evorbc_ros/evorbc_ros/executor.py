@@ -22,8 +22,9 @@ import numpy as np
 from evorbc_ros.laser import InputError
 from evorbc_ros.robots.four_ws import FourWSGeometry, FourWSType
 
-#: Why the robot stands after an empty primitive message.
-NO_PRIMITIVE_REASON = "the arbitrator chose no primitive (its network's outputs are not finite)"
+#: Why the robot stands after an empty primitive message: the arbitrator's network gave
+#: outputs that are not finite, or the arbitrator was deactivated (it says which).
+NO_PRIMITIVE_REASON = "the arbitrator sent no primitive (outputs not finite, or it was deactivated)"
 
 
 @dataclass(frozen=True)

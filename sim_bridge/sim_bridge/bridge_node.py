@@ -44,13 +44,12 @@ from sensor_msgs.msg import JointState, LaserScan
 
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.config import ConfigError
+from evorbc_ros.health import WARN, Health, Meter
 from evorbc_ros.nodes.common import (
     LATCHED,
     RELIABLE,
     Executor,
     StartupError,
-    declare,
-    finite_parameter,
     init_ros,
     logged_startup,
     quiet_teardown,
@@ -58,8 +57,10 @@ from evorbc_ros.nodes.common import (
     running,
     stop_requested,
 )
+from evorbc_ros.nodes.diagnostics import DiagnosticsPublisher
+from evorbc_ros.nodes.parameters import ParameterGuard, declare_all
 from evorbc_ros.robots import registry
-from evorbc_ros.robots.registry import DEFAULT_ROBOT
+from sim_bridge.bridge_parameters import PARAMETERS, REMOVED
 
 
 def stamp(seconds: float) -> Time:
@@ -74,54 +75,20 @@ class SimBridgeNode(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__("sim_bridge", **kwargs)
         with logged_startup(self):
-            maze_name = declare(self, "maze", "obstacle", "maze name or maze YAML file")
-            robot = declare(self, "robot", DEFAULT_ROBOT, "robot type")
+            p = self.params = declare_all(self, PARAMETERS, "at start-up", REMOVED)
+            robot = p["robot"]
             spec = robot_named(robot)
-            self.mode = declare(self, "mode", "lockstep", "lockstep or realtime")
-            gui = declare(self, "gui", False, "open the PyBullet GUI window")
-            start = declare(self, "start", "nominal", "nominal, random, or 'x,y,heading_deg'")
-            seed = declare(self, "seed", 0, "seed of a random start")
-            episode_time = finite_parameter(
-                self,
-                "episode_time",
-                spec.episode_time,
-                "episode length T (s; default: the robot's own, e.g. 120 for the 4WS robots)",
-                positive=True,
-            )
-            self.lockstep_timeout = finite_parameter(
-                self,
-                "lockstep_timeout",
-                30.0,
-                "wall seconds without commands before the state is sent again anyway",
-                positive=True,
-            )
-            self.wait_subscribers = declare(
-                self,
-                "wait_for_subscribers",
-                ["scan", "odom"],
-                "topics that need a subscriber before the run starts",
-            )
-            self.wait_publishers = declare(
-                self,
-                "wait_for_publishers",
-                [*spec.command_topics, "evorbc/primitive"],
-                "topics that need a publisher before the run starts",
-            )
-            self.startup_timeout = finite_parameter(
-                self, "startup_timeout", 30.0, "wall seconds to wait for the graph", positive=True
-            )
-            self.result_file = declare(self, "result_file", "", "write the result here (JSON)")
-            self.progress_period = finite_parameter(
-                self,
-                "progress_period",
-                10.0,
-                "simulated seconds between progress lines",
-                positive=True,
-            )
-            if self.mode not in ("lockstep", "realtime"):
-                raise StartupError(
-                    f"parameter mode must be lockstep or realtime, got {self.mode!r}"
-                )
+            self.mode = p["mode"]
+            episode_time = p["episode_time"] or spec.episode_time
+            self.lockstep_timeout = p["lockstep_timeout"]
+            self.wait_subscribers = list(p["wait_for_subscribers"])
+            self.wait_publishers = list(p["wait_for_publishers"]) or [
+                *spec.command_topics,
+                "evorbc/primitive",
+            ]
+            self.startup_timeout = p["startup_timeout"]
+            self.result_file = p["result_file"]
+            self.progress_period = p["progress_period"]
             # Imported here, after rclpy.init: numba and PyBullet take seconds to load, and
             # a graph shut down meanwhile (another node refused to start) would otherwise
             # interrupt the import with a KeyboardInterrupt traceback.
@@ -129,12 +96,15 @@ class SimBridgeNode(Node):
             from sim_bridge.maze import load_named_maze
 
             try:
-                maze = load_named_maze(maze_name)
+                maze = load_named_maze(p["maze"])
             except ConfigError as e:
                 raise StartupError(f"parameter maze: {e}") from None
             kind = bridge_robot_class(robot)
-            pose = self._start_pose(maze, start, seed, spec.footprint_radius, robot)
-            self.robot = kind(self, robot, maze, pose, episode_time, gui)
+            pose = self._start_pose(maze, p["start"], p["seed"], spec.footprint_radius, robot)
+            self.robot = kind(self, robot, maze, pose, episode_time, p["gui"])
+        ParameterGuard(self, PARAMETERS, "at start-up")
+        self.steps = Meter()
+        self.diagnostics = DiagnosticsPublisher(self, p["diagnostics_period"], self.health, robot)
         self.world = self.robot.world
         self.trajectory = [list(self.world.pose)]
         self.fresh = dict.fromkeys(self.robot.command_keys, False)
@@ -241,6 +211,7 @@ class SimBridgeNode(Node):
     def advance(self) -> None:
         """Step the world with the latest commands and log progress."""
         self.robot.advance()
+        self.steps.tick(time.monotonic())
         self.trajectory.append(list(self.world.pose))
         status = self.world.status()
         if status.time >= self.next_progress - 1e-9:
@@ -248,6 +219,19 @@ class SimBridgeNode(Node):
             self.get_logger().info(
                 f"t = {status.time:5.1f} s, {status.distance:.2f} m to the target"
             )
+
+    def health(self, now: float) -> Health:
+        """Simulated time, distance to the target, steps per wall second, missing nodes."""
+        h = Health()
+        status = self.world.status()
+        h.add("mode", self.mode)
+        h.add("simulated time (s)", status.time)
+        h.add("distance to the target (m)", status.distance)
+        h.add("steps per second", self.steps.rate(time.monotonic()))
+        missing = self.missing()
+        if missing:
+            h.worse(WARN, f"waiting for {', '.join(missing)}")
+        return h
 
     # -- running -----------------------------------------------------------------------
 
@@ -271,6 +255,8 @@ class SimBridgeNode(Node):
         deadline = time.monotonic() + self.startup_timeout
         while self.missing() and time.monotonic() < deadline and running():
             executor.spin_once(timeout_sec=0.05)
+        if not running():
+            return  # stopped while waiting (the launch shut the graph down)
         if self.missing():
             self.get_logger().warning(f"starting without {', '.join(self.missing())}")
             return

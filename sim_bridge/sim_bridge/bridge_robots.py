@@ -20,13 +20,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from evorbc_ros.nodes.common import (
-    RELIABLE,
-    StartupError,
-    declare,
-    finite_parameter,
-    robot_named,
-)
+from evorbc_ros.nodes.common import RELIABLE, StartupError, robot_named
 from evorbc_ros.robots.four_ws import WHEEL_NAMES
 from evorbc_ros.robots.hexapod import JOINT_NAMES
 from evorbc_ros.robots.registry import RobotError
@@ -53,12 +47,7 @@ class KinematicBridge:
 
     def _laser(self, node) -> LaserConfig:
         """The simulated scanner from the node's parameters; sets :attr:`scan_geometry`."""
-        laser = LaserConfig(
-            beams=declare(node, "laser_beams", 360, "laser beams per scan"),
-            range_max=finite_parameter(node, "laser_range", 2.0, "laser range (m)", positive=True),
-        )
-        if laser.beams < 1:
-            raise StartupError("parameter laser_beams must be at least 1")
+        laser = LaserConfig(beams=node.params["laser_beams"], range_max=node.params["laser_range"])
         self.scan_geometry = ScanGeometry(
             laser.angle_min,
             laser.angle_min + laser.increment * (laser.beams - 1),
@@ -86,24 +75,13 @@ class FourWSBridge(KinematicBridge):
 
     def __init__(self, node, robot: str, maze, pose, episode_time: float, gui: bool) -> None:
         self.node = node
-        self.wheel_radius = finite_parameter(
-            node,
-            "wheel_radius",
-            robot_named(robot).node_default("wheel_radius", 0.02),
-            "wheel radius (m)",
-            positive=True,
+        self.wheel_radius = node.params["wheel_radius"] or robot_named(robot).node_default(
+            "wheel_radius", 0.02
         )
         laser = self._laser(node)
         self.topics = {
-            "steering": declare(
-                node,
-                "steering_topic",
-                "steering_position_controller/commands",
-                "steering command topic",
-            ),
-            "wheel": declare(
-                node, "wheel_topic", "wheel_velocity_controller/commands", "wheel command topic"
-            ),
+            "steering": "steering_position_controller/commands",
+            "wheel": "wheel_velocity_controller/commands",
         }
         self.world = SimWorld(maze, robot, pose, episode_time, laser, gui)
         self.commands: dict[str, np.ndarray | None] = {"steering": None, "wheel": None}
@@ -177,12 +155,7 @@ class TrajectoryBridge:
     def __init__(self, node, robot: str, maze, pose, episode_time: float, gui: bool) -> None:
         self.node = node
         self.name = robot
-        self.topic = declare(
-            node,
-            "trajectory_topic",
-            "joint_trajectory_controller/joint_trajectory",
-            "joint trajectory command topic",
-        )
+        self.topic = "joint_trajectory_controller/joint_trajectory"
         self.world = self.make_world(robot, maze, pose, episode_time, gui)
         # The latest trajectory resampled at the physics steps, and the next step to run:
         # a trajectory longer than a period keeps the legs walking until the next arrives.

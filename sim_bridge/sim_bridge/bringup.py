@@ -236,13 +236,17 @@ def prepare(args: argparse.Namespace) -> tuple[Controller, Maze, str]:
 
 
 def main(argv=None) -> int:
-    """Run one episode through the graph; 0 if it ran (reached or not), 1 on errors."""
+    """Run one episode through the graph.
+
+    Returns 0 if it ran (reached or not), 2 on a bad option, file or setting (one line,
+    before any node starts), 1 when a node was refused or died, 130 after Ctrl-C.
+    """
     args = parse_args(argv)
     try:
         return run(args)
     except (ConfigError, ArbitratorError, RepertoireError) as e:
         print(f"evorbc-sim: error: {e}", file=sys.stderr)
-        return 1
+        return 2
     except KeyboardInterrupt:
         print("evorbc-sim: interrupted", file=sys.stderr)
         return 130

@@ -1,11 +1,11 @@
 """The bridge adapter of a differential-drive robot: body twists on ``cmd_vel`` in.
 
-A differential-drive base takes ``geometry_msgs/Twist`` on ``cmd_vel`` (a TurtleBot3's
-base, nav2's controllers, ros2_control's diff_drive_controller), so that is what the
-executor publishes (:mod:`evorbc_ros.nodes.twist_commands`) and this adapter applies: the
-twist, as received, is the command of the compiled motion model, so a lockstep episode
-equals the offline one bit for bit (docs/design.md section 19). The adapter interface is
-in docs/your-robot.md.
+A differential-drive base takes a body twist on ``cmd_vel``: geometry_msgs/TwistStamped
+(ros2_control's diff_drive_controller from Jazzy on) or, with ``twist_stamped: false``,
+geometry_msgs/Twist (a TurtleBot3's base, older stacks), as the executor publishes it
+(:mod:`evorbc_ros.nodes.twist_commands`) with the same parameter. The twist, as received,
+is the command of the compiled motion model, so a lockstep episode equals the offline one
+bit for bit (docs/design.md section 19). The adapter interface is in docs/your-robot.md.
 """
 
 from __future__ import annotations
@@ -13,10 +13,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from geometry_msgs.msg import Twist
+from geometry_msgs.msg import Twist, TwistStamped
 from sensor_msgs.msg import JointState
 
-from evorbc_ros.nodes.common import RELIABLE, declare, robot_named
+from evorbc_ros.nodes.common import RELIABLE, robot_named
 from evorbc_ros.robots.diff_drive import WHEEL_JOINTS
 from sim_bridge.bridge_robots import KinematicBridge
 from sim_bridge.diff_drive_world import DiffDriveWorld
@@ -32,7 +32,8 @@ class DiffDriveBridge(KinematicBridge):
         self.node = node
         self.robot_name = robot
         laser = self._laser(node)
-        self.topic = declare(node, "cmd_vel_topic", "cmd_vel", "body twist topic (Twist)")
+        self.topic = "cmd_vel"
+        self.stamped = node.params["twist_stamped"]
         self.world = DiffDriveWorld(maze, robot, pose, episode_time, laser, gui)
         self.wheel_radius = robot_named(robot).model.wheel_radius  # m, for joint states
         self.command = np.zeros(2)  # (v m/s, omega rad/s): stand still until told
@@ -44,14 +45,16 @@ class DiffDriveBridge(KinematicBridge):
 
     def subscribe(self, on_command) -> list:
         """The twist subscription; ``on_command("cmd_vel")`` after a valid twist is stored."""
+        kind = TwistStamped if self.stamped else Twist
         return [
             self.node.create_subscription(
-                Twist, self.topic, lambda m: self._store(m, on_command), RELIABLE
+                kind, self.topic, lambda m: self._store(m, on_command), RELIABLE
             )
         ]
 
-    def _store(self, msg: Twist, on_command) -> None:
-        values = (msg.linear.x, msg.angular.z)
+    def _store(self, msg: Twist | TwistStamped, on_command) -> None:
+        twist = msg.twist if self.stamped else msg
+        values = (twist.linear.x, twist.angular.z)
         if not all(math.isfinite(v) for v in values):
             self.node.get_logger().warning(
                 f"{self.topic}: twist must be finite, got linear.x {values[0]}, angular.z "

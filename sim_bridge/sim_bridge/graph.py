@@ -10,9 +10,9 @@ Both fill in the same defaults: the robot's shipped controller when no arbitrato
 (its paper-protocol one with ``paper``; none for a 4WS type other than 4ws-5: the
 arbitrator node then refuses to start and says how to make one), the robot's maze,
 the episode length the controller was evolved with (its file's task), simulated time for
-the four evorbc nodes, the parameter files ``config/ros/*.yaml`` under
-every node, and the ``robot`` parameter on the arbitrator, which refuses a controller for
-another robot.
+the four evorbc nodes, each node's parameter file ``config/ros/<node>.yaml``, the
+``robot`` parameter on the arbitrator, which refuses a controller for another robot, and
+which nodes are lifecycle nodes (the launch file drives their transitions).
 """
 
 from __future__ import annotations
@@ -94,6 +94,7 @@ class NodeSpec:
         parameters: overrides on top of it (empty values are left out: every empty
             default means "none", and the file may set one).
         required: the graph is over when this node exits, whatever its status.
+        managed: a lifecycle node (configure, activate; docs/design.md section 9).
     """
 
     name: str
@@ -102,6 +103,7 @@ class NodeSpec:
     param_file: Path
     parameters: dict = field(default_factory=dict)
     required: bool = False
+    managed: bool = False
 
 
 @dataclass(frozen=True)
@@ -183,13 +185,12 @@ def sim_graph(
             "controller shipped for robot"
         )
     arbitrator = arbitrator or shipped_arbitrator(robot, paper)
-    nodes_file = config_dir() / "ros" / "evorbc_nodes.yaml"
     sim_time = {"use_sim_time": True}
 
-    def evorbc(name: str, **params) -> NodeSpec:
-        return NodeSpec(
-            name, "evorbc_ros", f"evorbc_ros.nodes.{name}", nodes_file, _given(sim_time | params)
-        )
+    def evorbc(name: str, managed: bool = False, **params) -> NodeSpec:
+        module = f"evorbc_ros.nodes.{name}"
+        given = _given(sim_time | params)
+        return NodeSpec(name, "evorbc_ros", module, param_file(name), given, managed=managed)
 
     return SimGraph(
         (
@@ -197,17 +198,18 @@ def sim_graph(
             evorbc("radar_sensor", sensor_layout=arbitrator),
             evorbc(
                 "arbitrator",
+                managed=True,
                 arbitrator=arbitrator,
                 repertoire=repertoire,
                 robot=robot,
                 record_file=record_file,
             ),
-            evorbc("primitive_executor", robot=robot),
+            evorbc("primitive_executor", managed=True, robot=robot),
             NodeSpec(
                 "sim_bridge",
                 "sim_bridge",
                 "sim_bridge.bridge_node",
-                config_dir() / "ros" / "sim_bridge.yaml",
+                param_file("sim_bridge"),
                 _given(
                     {
                         "robot": robot,
@@ -225,6 +227,11 @@ def sim_graph(
         ),
         namespace.strip("/"),
     )
+
+
+def param_file(node: str) -> Path:
+    """The shipped parameter file of ``node`` (``config/ros/<node>.yaml``)."""
+    return config_dir() / "ros" / f"{node}.yaml"
 
 
 def _given(params: dict) -> dict:

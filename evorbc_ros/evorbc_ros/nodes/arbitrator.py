@@ -1,14 +1,19 @@
-"""``arbitrator``: sensor readings -> network -> mapping -> primitive.
+"""``arbitrator``: sensor readings -> network -> mapping -> primitive (a lifecycle node).
 
 Subscribes ``evorbc/rangefinders`` and ``evorbc/goal_sectors`` (Float64MultiArray); once
 both have a new message it publishes the chosen primitive's genes on ``evorbc/primitive``
 (Float64MultiArray, labelled with the parameter names) and, for EvoRBC, the diagnostic
 ``evorbc/mapping`` = ``[m1, m2, x, y, primitive index]``, also appended to ``record_file``
-(JSON lines) if set. A recurrent network's state starts at 0 with the node; the service
-``~/reset`` (std_srvs/Empty) sets it back to 0, for a new goal or a new run. By default it
-runs the arbitrator and repertoire shipped with the package, so ``ros2 run evorbc_ros
-arbitrator`` needs no arguments. Bad files, a repertoire/sensor mismatch, or a controller
-for another robot than the ``robot`` parameter stop it at start-up with one line.
+(JSON lines) if set. A recurrent network's state starts at 0 at every activation; the
+service ``~/reset`` (std_srvs/Empty) sets it back to 0, for a new goal or a new run.
+
+Configure loads and checks the files (by default the arbitrator and repertoire shipped for
+``robot``, so ``ros2 run evorbc_ros arbitrator`` needs no arguments): a bad file, a
+repertoire or sensor mismatch, or a controller for another robot than ``robot`` fails it in
+one line. Activate starts choosing, at once if a full set of readings came meanwhile;
+deactivate publishes an empty primitive, which stops the robot. Health on
+``/diagnostics``; with ``markers`` the mapping's target and the chosen primitive's
+expected displacement on ``~/markers`` (:mod:`evorbc_ros.nodes.managed`).
 """
 
 from __future__ import annotations
@@ -19,125 +24,81 @@ import os
 import sys
 
 import numpy as np
-from rclpy.node import Node
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Empty
+from visualization_msgs.msg import MarkerArray
 
 from evorbc_ros.arbitration import Controller, InputGroups
 from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, ships_controller
+from evorbc_ros.health import ERROR, WARN, Health, Meter, report_input, report_skipped
 from evorbc_ros.laser import InputError
+from evorbc_ros.marker_geometry import primitive_arrows
+from evorbc_ros.node_parameters import PARAMETERS
 from evorbc_ros.nodes.common import (
     DIAGNOSTICS,
-    RELIABLE,
     StartupError,
-    declare,
     load_sensor_layout,
-    logged_startup,
+    now_seconds,
     robot_named,
     run_node,
     vector_message,
     vector_values,
 )
+from evorbc_ros.nodes.managed import ManagedNode
+from evorbc_ros.nodes.markers import Markers, arrow, sphere
 from evorbc_ros.repertoire import RepertoireError
 
+#: The input groups, in the order of the network's inputs.
+INPUTS = ("evorbc/rangefinders", "evorbc/goal_sectors")
+#: s after which an input counts as old in the health report (three control periods).
+STALE = 0.3
 
-class ArbitratorNode(Node):
+
+class ArbitratorNode(ManagedNode):
     """Chooses a primitive whenever a full set of new readings has arrived."""
 
+    SPECS = PARAMETERS["arbitrator"]
+
     def __init__(self, **kwargs) -> None:
+        self.controller: Controller | None = None
+        self.groups: InputGroups | None = None
+        self.pub = self.map_pub = None
+        self.record = None
+        self.markers: Markers | None = None
+        self.meters = {t: Meter() for t in INPUTS}
+        self.skipped, self.choices, self.halts, self.failures = Meter(), Meter(), Meter(), Meter()
+        self.last_choice: list[float] = []
         super().__init__("arbitrator", **kwargs)
-        with logged_startup(self):
-            arbitrator = declare(
-                self,
-                "arbitrator",
-                "",
-                "arbitrator file (JSON); empty: the shipped one for robot (4ws-5 if unset)",
-            )
-            repertoire = declare(
-                self,
-                "repertoire",
-                "",
-                "repertoire file (JSON); empty: the shipped one for its robot",
-            )
-            robot = declare(
-                self,
-                "robot",
-                "",
-                "the robot driven (a registered robot, e.g. 4ws-5 or hexapod): a controller "
-                "for another is refused; empty: not checked",
-            )
-            allow = declare(
-                self,
-                "allow_mismatch",
-                False,
-                "run with a repertoire or sensor layout other than the arbitrator's",
-            )
-            layout_path = declare(
-                self,
-                "sensor_layout",
-                "",
-                "the sensor nodes' layout (YAML); empty: the arbitrator's own",
-            )
-            self.controller = load_controller(arbitrator, repertoire, robot, allow, layout_path)
-            rf_topic = declare(
-                self,
-                "rangefinder_topic",
-                "evorbc/rangefinders",
-                "rangefinder readings (Float64MultiArray)",
-            )
-            goal_topic = declare(
-                self, "goal_topic", "evorbc/goal_sectors", "goal readings (Float64MultiArray)"
-            )
-            out_topic = declare(
-                self,
-                "primitive_topic",
-                "evorbc/primitive",
-                "chosen primitive's genes (Float64MultiArray)",
-            )
-            map_topic = declare(
-                self,
-                "mapping_topic",
-                "evorbc/mapping",
-                "diagnostics [m1, m2, x, y, primitive] (Float64MultiArray)",
-            )
-            record = declare(
-                self,
-                "record_file",
-                "",
-                "append every choice here as JSON lines (m1, m2, x, y, primitive)",
-            )
-            # An existing non-regular file (a FIFO) would block open() until a reader comes.
-            if record and os.path.exists(record) and not os.path.isfile(record):
-                raise StartupError(f"parameter record_file: {record} is not a regular file")
-            try:
-                self.record = open(record, "a", buffering=1) if record else None  # noqa: SIM115
-            except OSError as e:
-                raise StartupError(
-                    f"parameter record_file: cannot open {record} ({e.strerror})"
-                ) from None
+        self.reset_service = self.create_service(Empty, "~/reset", self.on_reset)
+
+    # -- lifecycle ----------------------------------------------------------------------
+
+    def configure(self, params: dict) -> None:
+        """Load the controller and the record file; make the publishers and subscriptions."""
+        self.controller = load_controller(
+            params["arbitrator"],
+            params["repertoire"],
+            params["robot"],
+            params["allow_mismatch"],
+            params["sensor_layout"],
+        )
+        self.record = open_record(params["record_file"])
         for w in self.controller.warnings:
             self.get_logger().warning(w)
-        # The node starts with its episode (the bridge sends the first state once the graph
-        # is connected, in lockstep and real time), so a recurrent network starts from 0
-        # there, as offline; a restarted node starts from 0 again, mid-episode.
-        self.controller.reset()
-        if self.controller.recurrent:
-            self.get_logger().info("recurrent network: its state starts at 0")
-        self.reset_service = self.create_service(Empty, "~/reset", self.on_reset)
         spec = self.controller.spec
+        self.diagnostics.hardware_id = spec.robot
         layout = spec.sensors
         n_rf = len(layout.rangefinders.angles) if layout.rangefinders else 0
-        sizes = {rf_topic: n_rf, goal_topic: layout.n_inputs - n_rf}
+        sizes = dict(zip(INPUTS, (n_rf, layout.n_inputs - n_rf), strict=True))
         self.groups = InputGroups({k: v for k, v in sizes.items() if v > 0})
-        self.pub = self.create_publisher(Float64MultiArray, out_topic, RELIABLE)
-        self.map_pub = self.create_publisher(Float64MultiArray, map_topic, DIAGNOSTICS)
-        self.subs = [
-            self.create_subscription(
-                Float64MultiArray, topic, lambda msg, t=topic: self.on_input(t, msg), RELIABLE
-            )
-            for topic in self.groups.sizes
-        ]
+        self.pub = self.lifecycle_publisher(Float64MultiArray, "evorbc/primitive")
+        self.map_pub = self.lifecycle_publisher(Float64MultiArray, "evorbc/mapping", DIAGNOSTICS)
+        if params["markers"]:
+            pub = self.lifecycle_publisher(MarkerArray, "~/markers")
+            self.markers = Markers(self, params["marker_frame"], pub)
+        for t in self.groups.sizes:
+            self.subscription(Float64MultiArray, t, lambda msg, t=t: self.on_input(t, msg))
         self.get_logger().info(
             f"{spec.kind} controller for {spec.robot} from {self.controller.arbitrator_path}"
             + (
@@ -148,37 +109,76 @@ class ArbitratorNode(Node):
             )
         )
 
+    def activate(self) -> None:
+        """Start from a fresh network state; choose at once if a full set is waiting.
+
+        An episode starts with the node's activation (the bridge sends the first state once
+        the graph is up), so a recurrent network starts from 0 there, as offline.
+        """
+        self.controller.reset()
+        if self.controller.recurrent:
+            self.get_logger().info("recurrent network: its state starts at 0")
+        if all(self.groups.fresh.values()):
+            self.choose()
+
+    def deactivate(self) -> None:
+        """An empty primitive: the executor stops the robot at once."""
+        self.pub.publish(vector_message([]))
+        self.get_logger().info("deactivated: sent no primitive (the robot stops)")
+
+    def release(self) -> None:
+        """Close the record file; drop the subscriptions, publishers and controller."""
+        self.release_made()
+        self.pub = self.map_pub = self.markers = None
+        if self.record is not None:
+            self.record.close()
+            self.record = None
+        self.controller = None
+
+    # -- callbacks ----------------------------------------------------------------------
+
     def on_reset(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
         """``~/reset``: a recurrent network's state back to 0 (as at an episode's start).
 
         Readings already received for the current cycle are kept: the next choice uses
         them with the fresh state. A feed-forward network has no state; the call is logged
-        and changes nothing.
+        and changes nothing. Before configure there is nothing to reset.
         """
+        if self.controller is None:
+            self.get_logger().info("reset: not configured, nothing to reset")
+            return response
         self.controller.reset()
         what = "state set to 0" if self.controller.recurrent else "feed-forward, no state"
         self.get_logger().info(f"reset: {what}")
         return response
 
     def on_input(self, topic: str, msg: Float64MultiArray) -> None:
-        """Store one input group; choose once all are new.
+        """Store one input group; choose once all are new (and the node is active)."""
+        now = now_seconds(self)
+        try:
+            values = vector_values(msg, self.groups.sizes[topic], topic)
+        except InputError as e:
+            self.skipped.tick(now)
+            self.get_logger().warning(f"skipped a message: {e}", throttle_duration_sec=2.0)
+            return
+        self.meters[topic].tick(now)
+        if self.groups.put(topic, values) and self.active:
+            self.choose()
+
+    def choose(self) -> None:
+        """One choice from the held inputs: publish it, record it, draw it.
 
         A network whose outputs are not finite chooses no primitive: an empty message on
         the primitive topic stops the robot at once (the executor's rule), and the cycle
         is logged. So is any other failure of the choice, which must never end the node.
         """
-        try:
-            values = vector_values(msg, self.groups.sizes[topic], topic)
-        except InputError as e:
-            self.get_logger().warning(f"skipped a message: {e}", throttle_duration_sec=2.0)
-            return
-        if not self.groups.put(topic, values):
-            return
+        now = now_seconds(self)
         inputs = self.groups.take()
         try:
             genes, diagnostics = self.controller.step(inputs)
         except Exception as e:  # a controller bug must stop the robot, not the node
             genes, diagnostics = np.empty(0), []
+            self.failures.tick(now)
             self.get_logger().error(
                 f"choosing a primitive failed ({type(e).__name__}: {e}); the robot stops",
                 throttle_duration_sec=2.0,
@@ -186,23 +186,75 @@ class ArbitratorNode(Node):
         else:
             reason = self.controller.no_primitive_reason(inputs, genes, diagnostics)
             if reason:
+                self.halts.tick(now)
                 self.get_logger().warning(reason, throttle_duration_sec=2.0)
+        self.choices.tick(now)
+        self.last_choice = diagnostics or list(map(float, genes))
         names = self.controller.parameter_names if len(genes) else []
         self.pub.publish(vector_message(genes, names))
         if diagnostics:
             self.map_pub.publish(vector_message(diagnostics, ["m1", "m2", "x", "y", "primitive"]))
         if self.record is not None:
-            row = diagnostics or list(map(float, genes))
             # JSON has no NaN or infinity: a value outside float range is written as null.
-            row = [v if math.isfinite(v) else None for v in row]
+            row = [v if math.isfinite(v) else None for v in self.last_choice]
             self.record.write(json.dumps(row) + "\n")
+        if self.markers is not None and diagnostics:
+            self.publish_markers(diagnostics)
+
+    def publish_markers(self, row: list[float]) -> None:
+        """The mapping's target point, and the chosen primitive's expected motion."""
+        _, _, x, y, index = row
+        if not all(math.isfinite(v) for v in row):
+            return
+        rep = self.controller.repertoire
+        k = int(index)
+        move, turn = primitive_arrows(tuple(rep.behaviour[k]), float(rep.heading[k]), 0.1)
+        self.markers.publish(
+            [
+                sphere("mapping_target", (x, y), (1.0, 0.2, 0.8, 0.9), 0.05),
+                arrow("primitive", move, (0.2, 0.9, 0.2, 0.9), 0.02),
+                arrow("primitive", turn, (0.2, 0.9, 0.2, 0.9), 0.01, idx=1),
+            ]
+        )
+
+    def report(self, h: Health, now: float) -> None:
+        """Inputs, choices per second, the chosen primitive, skipped and failed choices."""
+        for topic in self.groups.sizes:
+            report_input(h, topic, self.meters[topic], now, STALE)
+        report_skipped(h, "input", self.skipped, now)
+        new_halts, new_failures = self.halts.new_since_report(), self.failures.new_since_report()
+        self.halts.rate(now)
+        self.failures.rate(now)
+        h.add("choices per second", self.choices.rate(now))
+        h.add("last choice", self.last_choice)
+        h.add("no primitive", self.halts.count)
+        h.add("failed choices", self.failures.count)
+        if new_halts:
+            h.worse(WARN, f"{new_halts} cycle(s) without a primitive (the robot stopped)")
+        if new_failures:
+            h.worse(ERROR, f"{new_failures} choice(s) failed (the robot stopped)")
 
     def destroy_node(self) -> None:
         """Close the record file, then the node."""
-        if self.record is not None:
-            self.record.close()
-            self.record = None
+        self.release()
         super().destroy_node()
+
+
+def open_record(path: str):
+    """``path`` opened for appending lines (None for ""), refusing what is not a file.
+
+    Raises:
+        StartupError: naming the parameter.
+    """
+    if not path:
+        return None
+    # An existing non-regular file (a FIFO) would block open() until a reader comes.
+    if os.path.exists(path) and not os.path.isfile(path):
+        raise StartupError(f"parameter record_file: {path} is not a regular file")
+    try:
+        return open(path, "a", buffering=1)
+    except OSError as e:
+        raise StartupError(f"parameter record_file: cannot open {path} ({e.strerror})") from None
 
 
 def load_controller(

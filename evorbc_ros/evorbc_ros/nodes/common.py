@@ -5,10 +5,9 @@ Conventions (docs/design.md section 9): sensor streams from other stacks are sub
 subscriber still receives it); the goal is latched (transient local) so a node that starts
 late still gets it.
 
-Parameters are read once, at start-up, and declared read-only, so ``ros2 param set`` says
-so instead of claiming a success that changes nothing; the few that a node applies live
-say so in their description and are validated when set. A node that cannot start logs one
-line through its own logger (console, ``/rosout`` and the log file) and exits with status 2.
+Parameters are declared from each node's table (:mod:`evorbc_ros.nodes.parameters`). A
+node that cannot start logs one line through its own logger (console, ``/rosout`` and the
+log file) and exits with status 2.
 """
 
 from __future__ import annotations
@@ -220,6 +219,9 @@ def run_node(make: Callable[[], Node], argv: Sequence[str] | None = None) -> int
     try:
         node = make()
         spin_until_stopped(node)
+        finish = getattr(node, "finish", None)  # a lifecycle node stops the robot
+        if finish is not None and rclpy.ok(context=node.context):
+            finish()
     except StartupError as e:
         if not e.logged:
             print(f"error: {e}", file=sys.stderr)
@@ -235,42 +237,6 @@ def run_node(make: Callable[[], Node], argv: Sequence[str] | None = None) -> int
             node.destroy_node()
         rclpy.try_shutdown()
     return 0
-
-
-def declare(
-    node: Node,
-    name: str,
-    default,
-    description: str,
-    any_type: bool = False,
-    live: bool = False,
-):
-    """Declare a parameter with a description and return its value.
-
-    Args:
-        any_type: accept an override of any type (the caller checks it), so that
-            ``-p rate:=100`` reaches a float parameter as an int instead of failing.
-        live: the node applies changes while it runs (and validates them in its
-            set-parameters callback); otherwise the parameter is read-only after start-up.
-
-    Raises:
-        StartupError: the override has another type than ``default``.
-    """
-    from rcl_interfaces.msg import ParameterDescriptor
-    from rclpy.exceptions import InvalidParameterTypeException
-
-    descriptor = ParameterDescriptor(
-        description=description,
-        dynamic_typing=any_type,
-        read_only=not live,
-    )
-    try:
-        return node.declare_parameter(name, default, descriptor).value
-    except InvalidParameterTypeException:
-        kind = {bool: "true or false", int: "an integer", float: "a number", str: "a string"}
-        raise StartupError(
-            f"parameter {name} must be {kind.get(type(default), type(default).__name__)}"
-        ) from None
 
 
 def robot_named(name: str):
@@ -314,45 +280,3 @@ def load_sensor_layout(path: str):
         return SensorLayout.load(path)
     except (ConfigError, ArbitratorError) as e:
         raise StartupError(f"parameter sensor_layout: {e}") from None
-
-
-def sensor_layout_parameter(node: Node):
-    """Declare a sensor node's ``sensor_layout`` parameter and load the layout it names.
-
-    Raises:
-        StartupError: naming the file and the problem.
-    """
-    path = declare(
-        node,
-        "sensor_layout",
-        "",
-        "sensor layout YAML or arbitrator JSON; empty: the shipped 4ws-5 controller's",
-    )
-    return load_sensor_layout(path)
-
-
-def finite_parameter(
-    node: Node,
-    name: str,
-    default: float,
-    description: str,
-    positive: bool = False,
-    live: bool = False,
-) -> float:
-    """Declare a float parameter and check it is finite (and > 0 if ``positive``)."""
-    value = declare(node, name, float(default), description, any_type=True, live=live)
-    problem = finite_problem(name, value, positive)
-    if problem:
-        raise StartupError(problem)
-    return float(value)
-
-
-def finite_problem(name: str, value, positive: bool = False) -> str:
-    """Why ``value`` is not a finite (positive) number for parameter ``name``; "" if it is."""
-    import math
-
-    number = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if not number or not math.isfinite(value) or (positive and value <= 0):
-        need = "a positive number" if positive else "a finite number"
-        return f"parameter {name} must be {need}, got {value!r}"
-    return ""

@@ -2,9 +2,10 @@
 
 Named by legged registrations' ``commands`` field (:mod:`evorbc_ros.robots.builtin.legged`).
 The hexapod's interface (:mod:`evorbc_ros.nodes.trajectory_commands`) with the gait of the
-robot's settings file: on ``trajectory_topic`` (trajectory_msgs/JointTrajectory, reliable)
-its joints' targets (rad) for the next ``stale_timeout`` s, one point per physics step.
-Unless ``trajectory_rate`` is set, the points come at the robot's own physics rate
+robot's settings file: on ``joint_trajectory_controller/joint_trajectory``
+(trajectory_msgs/JointTrajectory, reliable) its joints' targets (rad) for the next
+``stale_timeout`` s, one point per physics step. Unless ``trajectory_rate`` is set (not 0),
+the points come at the robot's own physics rate
 (``physics.rate_hz`` of its settings file), the rate its simulation's servos track.
 """
 

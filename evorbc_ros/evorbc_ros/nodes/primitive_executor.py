@@ -1,9 +1,10 @@
-"""``primitive_executor``: runs the current primitive on the robot's controllers.
+"""``primitive_executor``: runs the current primitive on the robot's controllers (lifecycle).
 
-Subscribes ``evorbc/primitive`` (genes) and, to know that the sensors are alive,
-``evorbc/rangefinders`` and ``evorbc/goal_sectors``. What it publishes is the robot's
-command interface, named by its registration (:mod:`evorbc_ros.robots.registry`),
-following ros2_control's command conventions (reliable):
+Subscribes ``evorbc/primitive`` (genes) and, to know that the sensors are alive, the
+``watched_inputs`` (``evorbc/rangefinders`` and ``evorbc/goal_sectors``). What it publishes
+is the robot's command interface, named by its registration
+(:mod:`evorbc_ros.robots.registry`), following ros2_control's command conventions
+(reliable):
 
 * 4WS robots (:mod:`evorbc_ros.nodes.wheel_commands`), forward command controllers
   (std_msgs/Float64MultiArray): ``steering_position_controller/commands``, the four
@@ -16,9 +17,8 @@ following ros2_control's command conventions (reliable):
 * legged robots from a settings file, such as the A1
   (:mod:`evorbc_ros.nodes.legged_commands`): the same, for the robot's joints, at its own
   physics rate (the A1: 12 joints, 100 Hz) unless ``trajectory_rate`` is set.
-
-The node declares the parameters of both (topics, ``wheel_radius``, ``trajectory_rate``),
-whichever robot it drives, so one parameter file serves every robot.
+* differential drive (:mod:`evorbc_ros.nodes.twist_commands`): ``cmd_vel``,
+  geometry_msgs/TwistStamped (Twist with ``twist_stamped: false``).
 
 A command goes out at once for every new primitive, and again whenever 1.5 periods
 (0.15 s) pass without one, so the controllers keep receiving 10 Hz commands. If
@@ -30,181 +30,131 @@ Before the first message on ``evorbc/primitive`` nothing is published, so the ex
 does not fight another node (teleop) on the same controllers; ``zero_before_first_primitive``
 makes a 4WS executor send zero commands every period instead. A primitive labelled with
 another robot's parameter names is refused and logged as an error. ``wheel_radius`` is
-applied live (``ros2 param set``, validated); the other parameters are read-only.
+applied live (``ros2 param set``, validated). Configure loads the robot and its command
+interface; activate starts commanding (at once for a primitive that came meanwhile);
+deactivate stops the robot (:mod:`evorbc_ros.nodes.managed`).
 """
 
 from __future__ import annotations
 
 import sys
 
-from rcl_interfaces.msg import SetParametersResult
-from rclpy.node import Node
-from rclpy.parameter import Parameter
 from std_msgs.msg import Float64MultiArray
 
 from evorbc_ros.executor import NO_PRIMITIVE_REASON
+from evorbc_ros.health import ERROR, WARN, Health, Meter, report_input, report_skipped
 from evorbc_ros.laser import InputError
-from evorbc_ros.nodes.common import (
-    RELIABLE,
-    StartupError,
-    declare,
-    finite_parameter,
-    finite_problem,
-    logged_startup,
-    now_seconds,
-    robot_named,
-    run_node,
-)
+from evorbc_ros.node_parameters import PARAMETERS
+from evorbc_ros.nodes.common import StartupError, now_seconds, robot_named, run_node
+from evorbc_ros.nodes.managed import ManagedNode
 from evorbc_ros.robots import registry
-from evorbc_ros.robots.hexapod import SERVO_RATE
-from evorbc_ros.robots.registry import DEFAULT_ROBOT, RobotError
+from evorbc_ros.robots.registry import RobotError
+
+#: Why the robot stands after a deactivation.
+DEACTIVATED = "the executor was deactivated"
 
 
-class PrimitiveExecutorNode(Node):
+class PrimitiveExecutorNode(ManagedNode):
     """Publishes commands at 10 Hz and stops the robot when inputs go stale."""
 
+    SPECS = PARAMETERS["primitive_executor"]
+
     def __init__(self, **kwargs) -> None:
+        self.spec = None
+        self.commands = None
+        self.wheel_radius = 0.0
+        self.primitive, self.sent, self.skipped, self.refused = Meter(), Meter(), Meter(), Meter()
+        self.inputs: dict[str, Meter] = {}
         super().__init__("primitive_executor", **kwargs)
-        with logged_startup(self):
-            robot = declare(
-                self, "robot", DEFAULT_ROBOT, "robot type (a registered robot, e.g. 4ws-5)"
-            )
-            spec = robot_named(robot)
-            self.wheel_radius = finite_parameter(
-                self,
-                "wheel_radius",
-                spec.node_default("wheel_radius", 0.02),
-                "wheel radius (m), for wheel velocities; applied live",
-                positive=True,
-                live=True,
-            )
-            self.period = finite_parameter(self, "period", 0.1, "command period (s)", positive=True)
-            stale = finite_parameter(
-                self,
-                "stale_timeout",
-                0.3,
-                "stop when an input is older than this (s)",
-                positive=True,
-            )
-            self.zero_before_primitive = declare(
-                self,
-                "zero_before_first_primitive",
-                False,
-                "4WS: send zero commands every period until the first primitive arrives "
-                "(false: send nothing, so another node may drive the robot)",
-            )
-            primitive_topic = declare(
-                self, "primitive_topic", "evorbc/primitive", "primitive genes (Float64MultiArray)"
-            )
-            inputs = declare(
-                self,
-                "input_topics",
-                ["evorbc/rangefinders", "evorbc/goal_sectors"],
-                "sensor topics whose silence stops the robot",
-            )
-            declare(
-                self,
-                "steering_topic",
-                "steering_position_controller/commands",
-                "steering angles (Float64MultiArray, rad)",
-            )
-            declare(
-                self,
-                "wheel_topic",
-                "wheel_velocity_controller/commands",
-                "wheel velocities (Float64MultiArray, rad/s)",
-            )
-            declare(
-                self,
-                "trajectory_topic",
-                "joint_trajectory_controller/joint_trajectory",
-                "hexapod joint targets (JointTrajectory, rad)",
-            )
-            try:
-                interface = spec.load("commands")
-            except RobotError as e:
-                raise StartupError(str(e)) from None
-            # A joint-trajectory interface says its robot's own rate (a legged robot's
-            # physics rate); the wheel interfaces do not use it.
-            default_rate = getattr(interface, "default_rate", None)
-            finite_parameter(
-                self,
-                "trajectory_rate",
-                default_rate(spec) if default_rate else SERVO_RATE,
-                "legged robots' trajectory points per second (default: the robot's physics rate)",
-                positive=True,
-            )
-        self.robot = robot
-        self.parameter_names = list(spec.parameter_names)
-        self.primitive_topic = primitive_topic
-        # The robot's own command interface: the executor logic and its publishers.
-        self.commands = interface(self, spec, list(inputs), stale)
+
+    # -- lifecycle ----------------------------------------------------------------------
+
+    def configure(self, p: dict) -> None:
+        """The robot, its command interface (publishers), subscriptions and the timer."""
+        self.spec = robot_named(p["robot"])
+        self.diagnostics.hardware_id = self.spec.name
+        self.apply_live("wheel_radius", p["wheel_radius"])
+        self.period, self.stale_timeout = p["period"], p["stale_timeout"]
+        self.zero_before_primitive = p["zero_before_first_primitive"]
+        inputs = [f"evorbc/{name}" for name in p["watched_inputs"]]
+        try:
+            interface = self.spec.load("commands")
+        except RobotError as e:
+            raise StartupError(str(e)) from None
+        self.commands = interface(self, self.spec, inputs, self.stale_timeout)
         self.logic = self.commands.logic
-        self.subs = [
-            self.create_subscription(
-                Float64MultiArray, primitive_topic, self.on_primitive_message, RELIABLE
-            )
-        ]
-        self.subs += [
-            self.create_subscription(
-                Float64MultiArray, t, lambda msg, t=t: self.on_input(t), RELIABLE
-            )
-            for t in inputs
-        ]
+        self.parameter_names = list(self.spec.parameter_names)
+        self.inputs = {t: Meter() for t in inputs}
+        self.subscription(Float64MultiArray, "evorbc/primitive", self.on_primitive_message)
+        for t in inputs:
+            self.subscription(Float64MultiArray, t, lambda msg, t=t: self.on_input(t))
         self.last_publish = -float("inf")
         self.stopped_reason = ""
         self.primitive_seen = False  # nothing is published before the arbitrator speaks
-        self.add_on_set_parameters_callback(self.on_set_parameters)
-        self.timer = self.create_timer(self.period, self.on_timer)
+        self.timer(self.period, self.on_timer)
 
-    def on_set_parameters(self, params: list[Parameter]) -> SetParametersResult:
-        """Apply a valid ``wheel_radius`` at once (the others are read-only)."""
-        for p in params:
-            if p.name == "wheel_radius":
-                problem = finite_problem(p.name, p.value, positive=True)
-                if problem:
-                    return SetParametersResult(successful=False, reason=problem)
-        for p in params:
-            if p.name == "wheel_radius":
-                self.wheel_radius = float(p.value)
-        return SetParametersResult(successful=True)
+    def activate(self) -> None:
+        """Command the primitive that came while inactive, if any (or stop if it is old)."""
+        if self.primitive_seen:
+            now = now_seconds(self)
+            self.publish(self.logic.command(now), now, halt=self.logic.halted)
+
+    def deactivate(self) -> None:
+        """Stop the robot (if the executor was commanding it) before the publishers stop."""
+        if not (self.primitive_seen or self.zero_before_primitive):
+            return  # never commanded: leave the controllers to whoever drives them
+        now = now_seconds(self)
+        self.logic.on_primitive([], now)  # the arbitrator's "stop now", until a new one
+        command = self.logic.command(now)
+        self.commands.publish(command, halt=True)
+        self.get_logger().info(f"deactivated: robot stopped ({DEACTIVATED})")
+
+    def release(self) -> None:
+        """Drop the command interface, subscriptions and timer."""
+        self.release_made()
+        self.commands = None
+
+    def apply_live(self, name: str, value) -> None:
+        """``wheel_radius`` (m), 0 meaning the robot's own."""
+        if name == "wheel_radius" and self.spec is not None:
+            self.wheel_radius = value or self.spec.node_default("wheel_radius", 0.02)
+
+    # -- callbacks ----------------------------------------------------------------------
 
     def on_primitive_message(self, msg: Float64MultiArray) -> None:
         """Refuse a primitive labelled for another robot; otherwise run it."""
-        problem = primitive_mismatch(msg, self.robot, self.parameter_names)
+        now = now_seconds(self)
+        problem = primitive_mismatch(msg, self.spec.name, self.parameter_names)
         if problem:
+            self.refused.tick(now)
             self.get_logger().error(
-                f"{self.primitive_topic}: refused {problem}", throttle_duration_sec=2.0
+                f"evorbc/primitive: refused {problem}", throttle_duration_sec=2.0
             )
             return
-        self.primitive_seen = True
-        self.on_primitive(msg)
-
-    def on_primitive(self, msg: Float64MultiArray) -> None:
-        """Run a new primitive at once; an empty message stops the robot at once."""
-        now = now_seconds(self)
         try:
             self.logic.on_primitive(msg.data, now)
         except InputError as e:
-            self.get_logger().warning(
-                f"{self.primitive_topic}: skipped: {e}", throttle_duration_sec=2.0
-            )
+            self.skipped.tick(now)
+            self.get_logger().warning(f"evorbc/primitive: skipped: {e}", throttle_duration_sec=2.0)
             return
-        command = self.logic.command(now)
-        self.publish(command, now, halt=self.logic.halted)
+        self.primitive.tick(now)
+        self.primitive_seen = True
+        if self.active:
+            self.publish(self.logic.command(now), now, halt=self.logic.halted)
 
     def on_input(self, topic: str) -> None:
         """Note a sensor input; if the robot was stopped for it, run again at once."""
         now = now_seconds(self)
+        self.inputs[topic].tick(now)
         self.logic.on_input(topic, now)
-        if self.stopped_reason:
+        if self.stopped_reason and self.active:
             command = self.logic.command(now)
             if not command.stopped:
                 self.publish(command, now)
 
     def on_timer(self) -> None:
         """Stop on stale inputs; otherwise keep commands flowing at least every period."""
-        if not (self.primitive_seen or self.zero_before_primitive):
+        if not self.active or not (self.primitive_seen or self.zero_before_primitive):
             return  # never commanded: leave the controllers to whoever drives them (teleop)
         now = now_seconds(self)
         command = self.logic.command(now)
@@ -228,7 +178,24 @@ class PrimitiveExecutorNode(Node):
             self.get_logger().info("inputs are back: running the primitive again")
         self.stopped_reason = command.reason if command.stopped else ""
         self.commands.publish(command, halt)
+        self.sent.tick(now)
         self.last_publish = now
+
+    def report(self, h: Health, now: float) -> None:
+        """Inputs, commands per second, why the robot stands, refused primitives."""
+        report_input(h, "primitive", self.primitive, now, self.stale_timeout)
+        for topic, meter in self.inputs.items():
+            report_input(h, topic, meter, now, self.stale_timeout)
+        report_skipped(h, "primitive", self.skipped, now)
+        new_refused = self.refused.new_since_report()
+        self.refused.rate(now)
+        h.add("commands per second", self.sent.rate(now))
+        h.add("refused primitives", self.refused.count)
+        h.add("robot", f"stopped: {self.stopped_reason}" if self.stopped_reason else "running")
+        if self.stopped_reason:
+            h.worse(WARN, f"robot stopped: {self.stopped_reason}")
+        if new_refused:
+            h.worse(ERROR, f"{new_refused} primitive(s) for another robot refused")
 
 
 def primitive_mismatch(msg: Float64MultiArray, robot: str, names: list[str]) -> str:

@@ -1,7 +1,8 @@
 """The hexapod's onboard command interface: a ros2_control joint trajectory controller.
 
 Named by the hexapod registration's ``commands`` field (docs/your-robot.md). Publishes,
-reliable, ``trajectory_topic`` (trajectory_msgs/JointTrajectory): the 18 joints' targets
+reliable, ``joint_trajectory_controller/joint_trajectory`` (trajectory_msgs/JointTrajectory):
+the 18 joints' targets
 (rad) for the next ``stale_timeout`` s, one point per physics step (``trajectory_rate``,
 50 Hz), see :mod:`evorbc_ros.hexapod_executor`.
 """
@@ -13,7 +14,6 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from evorbc_ros.hexapod_executor import HexapodExecutor
 from evorbc_ros.legged_executor import JointTargets, LeggedExecutor
-from evorbc_ros.nodes.common import RELIABLE
 from evorbc_ros.robots.hexapod import JOINT_NAMES, SERVO_RATE
 
 
@@ -21,8 +21,8 @@ class JointTrajectoryCommands:
     """The current gait as joint-target trajectories.
 
     Args:
-        node: the ``primitive_executor`` node; its parameters ``trajectory_topic`` and
-            ``trajectory_rate`` (points per second) are used.
+        node: the ``primitive_executor`` node: its lifecycle publishers, and its parameter
+            ``trajectory_rate`` (points per second; 0: :meth:`default_rate`).
         robot: the robot's registration.
         inputs: sensor topics whose silence stops the robot.
         stale_timeout: s, inputs older than this stop the robot (and how far ahead a
@@ -31,16 +31,16 @@ class JointTrajectoryCommands:
     """
 
     def __init__(self, node, robot, inputs: list[str], stale_timeout: float) -> None:
-        rate = float(node.get_parameter("trajectory_rate").value)
+        rate = float(node.get_parameter("trajectory_rate").value) or self.default_rate(robot)
         self.logic = self.executor(robot, inputs, stale_timeout, rate)
         self.joint_names = list(self.logic.gait.joint_names)
-        self.pub = node.create_publisher(
-            JointTrajectory, node.get_parameter("trajectory_topic").value, RELIABLE
+        self.pub = node.lifecycle_publisher(
+            JointTrajectory, "joint_trajectory_controller/joint_trajectory"
         )
 
     @staticmethod
     def default_rate(robot) -> float:
-        """Trajectory points per second when ``trajectory_rate`` is not set: 50 Hz."""
+        """Trajectory points per second when ``trajectory_rate`` is 0: 50 Hz."""
         return SERVO_RATE
 
     @staticmethod

@@ -1,0 +1,75 @@
+"""The simulation bridge's parameters as data (:mod:`evorbc_ros.node_parameters`'s way).
+
+Declared by the bridge node at start-up, whichever robot it simulates, so one parameter
+file (``config/ros/sim_bridge.yaml``) serves every robot; the robot adapters read theirs
+from it (docs/design.md section 9).
+"""
+
+from __future__ import annotations
+
+from evorbc_ros.node_parameters import COMMON, spec
+
+PARAMETERS = (
+    spec("maze", "obstacle", "maze name (config/mazes) or maze YAML file"),
+    spec("robot", "4ws-5", "robot type (a registered robot)"),
+    spec(
+        "mode",
+        "lockstep",
+        "lockstep (deterministic, as fast as the graph) or realtime (10 Hz wall clock)",
+        choices=("lockstep", "realtime"),
+    ),
+    spec("gui", False, "open the PyBullet window"),
+    spec("start", "nominal", "start pose: nominal, random, or 'x,y,heading_deg'"),
+    spec("seed", 0, "seed of a random start", 0, 2**32 - 1),
+    spec(
+        "episode_time",
+        0.0,
+        "episode length T (s); 0: the robot's own (120 for the 4WS robots)",
+        0.0,
+        1e6,
+    ),
+    spec(
+        "lockstep_timeout",
+        30.0,
+        "wall seconds without commands before the state is sent again anyway",
+        0.1,
+        3600.0,
+    ),
+    spec(
+        "wait_for_subscribers",
+        ("scan", "odom"),
+        "topics that need a subscriber before the run starts",
+    ),
+    spec(
+        "wait_for_publishers",
+        (),
+        "topics that need a publisher before the run starts; empty: the robot's command "
+        "topics and evorbc/primitive",
+    ),
+    spec("startup_timeout", 30.0, "wall seconds to wait for the graph", 0.1, 3600.0),
+    spec("result_file", "", "write the episode result here (JSON)"),
+    spec("progress_period", 10.0, "simulated seconds between progress lines", 0.1, 1e6),
+    spec("laser_beams", 360, "kinematic robots: laser beams per scan over 360 deg", 1, 100000),
+    spec("laser_range", 2.0, "kinematic robots: laser range (m)", 0.01, 1000.0),
+    spec(
+        "wheel_radius",
+        0.0,
+        "4WS: wheel radius (m), as the executor's; 0: the robot's own",
+        0.0,
+        10.0,
+    ),
+    spec(
+        "twist_stamped",
+        True,
+        "differential drive: cmd_vel is TwistStamped (false: Twist), as the executor's",
+    ),
+    *COMMON,
+)
+
+#: Topic-name parameters of earlier versions -> the topic to remap.
+REMOVED = {
+    "steering_topic": "steering_position_controller/commands",
+    "wheel_topic": "wheel_velocity_controller/commands",
+    "trajectory_topic": "joint_trajectory_controller/joint_trajectory",
+    "cmd_vel_topic": "cmd_vel",
+}
