@@ -30,6 +30,7 @@ ROSDEP = {
     "numba": "python3-numba",
     "pybullet": "python3-pybullet-pip",
     "pybullet_data": "python3-pybullet-pip",
+    "rosbags": "python3-rosbags-pip",
 }
 #: Optional imports (pip extras that rosdep has no key for): they must sit in a
 #: ``try``/``except ImportError`` that tells the user which extra to install.
