@@ -1,7 +1,8 @@
 """The ``sim_bridge`` ROS 2 package for colcon (ament_python); pip uses ../pyproject.toml.
 
-Name, version and licence come from package.xml; the bridge node and ``evorbc-sim`` are
-installed to ``lib/sim_bridge`` for ``ros2 run`` (setup.cfg; docs/design.md section 10).
+Name, version and licence come from package.xml; the bridge node, the recorder,
+``evorbc-sim`` and ``evorbc-play`` are installed to ``lib/sim_bridge`` for ``ros2 run``
+(setup.cfg; docs/design.md section 10).
 """
 
 import re
@@ -25,7 +26,9 @@ setup(
     entry_points={
         "console_scripts": [
             f"{PACKAGE} = {PACKAGE}.bridge_node:main",
+            f"recorder = {PACKAGE}.recorder:main",
             f"evorbc-sim = {PACKAGE}.bringup:main",
+            f"evorbc-play = {PACKAGE}.player:main",
         ],
     },
 )

@@ -13,6 +13,7 @@ import re
 import shutil
 import signal
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -33,9 +34,9 @@ NODES = [
     ("sim_bridge", "sim_bridge", "maze:=no-such-maze", "parameter maze"),
 ]
 
-needs_ros2 = pytest.mark.skipif(
-    shutil.which("ros2") is None, reason="needs the ros2 CLI and launch (a full ROS 2)"
-)
+#: The ros2 CLI beside the Python running the tests, or on the PATH.
+ROS2 = shutil.which("ros2", path=f"{Path(sys.executable).parent}:{os.environ.get('PATH', '')}")
+needs_ros2 = pytest.mark.skipif(ROS2 is None, reason="needs the ros2 CLI and launch (a full ROS 2)")
 
 
 def clean_env(domain: int, **extra: str) -> dict:

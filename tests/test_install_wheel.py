@@ -148,6 +148,13 @@ def test_every_node_refuses_a_bad_setting_in_one_fatal_line(
     assert_fatal_line(done, name, message)
 
 
+def test_the_recorder_records_only_what_it_is_told(venv, tmp_path):
+    exe = executable(venv, "sim_bridge", "recorder", tmp_path)
+    env = venv_env(venv, 0) | {"ROS_AUTOMATIC_DISCOVERY_RANGE": "OFF"}
+    done = run([exe], env, tmp_path, timeout=120, check=False)
+    assert_fatal_line(done, "recorder", "parameter bag must name the bag folder to create")
+
+
 def test_the_console_scripts_work_with_their_defaults(venv, tmp_path):
     env = venv_env(venv, 0)
     rep = tmp_path / "r.json"
@@ -232,4 +239,5 @@ def test_ros2_lifecycle_param_and_diagnostics_from_the_wheel(venv, tmp_path):
     finally:
         os.killpg(node.pid, signal.SIGINT)
         out = node.communicate(timeout=30)[0]
+        ros2("daemon", "stop")  # the CLI started one for this domain
     assert node.returncode == 0 and "Traceback" not in out, out

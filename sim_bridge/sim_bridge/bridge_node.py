@@ -41,6 +41,7 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState, LaserScan
+from std_msgs.msg import Empty
 
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.config import ConfigError
@@ -253,12 +254,23 @@ class SimBridgeNode(Node):
         already seen it would then answer twice.
         """
         deadline = time.monotonic() + self.startup_timeout
-        while self.missing() and time.monotonic() < deadline and running():
+        heard: set[str] = set()
+        ready = [
+            self.create_subscription(Empty, t, lambda _, t=t: heard.add(t), LATCHED)
+            for t in self.params["wait_for_ready"]
+        ]
+
+        def missing() -> list[str]:
+            return self.missing() + [t for t in self.params["wait_for_ready"] if t not in heard]
+
+        while missing() and time.monotonic() < deadline and running():
             executor.spin_once(timeout_sec=0.05)
+        for sub in ready:
+            self.destroy_subscription(sub)
         if not running():
             return  # stopped while waiting (the launch shut the graph down)
-        if self.missing():
-            self.get_logger().warning(f"starting without {', '.join(self.missing())}")
+        if missing():
+            self.get_logger().warning(f"starting without {', '.join(missing())}")
             return
         # Both ends of a new DDS connection match at about the same time; give the far
         # end a moment before the first reliable message.

@@ -46,6 +46,12 @@ PARAMETERS = (
         "topics that need a publisher before the run starts; empty: the robot's command "
         "topics and evorbc/primitive",
     ),
+    spec(
+        "wait_for_ready",
+        (),
+        "latched std_msgs/Empty topics to hear on before the run starts (a recorder's "
+        "recorder/ready, so that the bag holds the run from its first state)",
+    ),
     spec("startup_timeout", 30.0, "wall seconds to wait for the graph", 0.1, 3600.0),
     spec("result_file", "", "write the episode result here (JSON)"),
     spec("progress_period", 10.0, "simulated seconds between progress lines", 0.1, 1e6),

@@ -97,6 +97,12 @@ def parse_args(argv=None) -> argparse.Namespace:
         help=f"ROS_DOMAIN_ID for the graph, 0 to {MAX_DOMAIN_ID} (default: the environment's, "
         "else 0)",
     )
+    p.add_argument(
+        "--bag",
+        default="",
+        help="record the run's topics into this new folder, a rosbag2 bag in MCAP storage "
+        "(ros2 bag info and Foxglove open it; evorbc-play plays it back)",
+    )
     p.add_argument("--quiet", action="store_true", help="only the result line")
     return p.parse_args(argv)
 
@@ -146,17 +152,24 @@ class Graph:
         return proc
 
     def stop(self, timeout: float = 5.0) -> None:
-        """SIGINT every node, then SIGKILL whatever is still running after ``timeout``."""
-        for proc in self.procs.values():
-            if proc.poll() is None:
-                proc.send_signal(signal.SIGINT)
-        deadline = time.monotonic() + timeout
-        for proc in self.procs.values():
-            try:
-                proc.wait(max(0.0, deadline - time.monotonic()))
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+        """SIGINT every node, then SIGKILL whatever is still running after ``timeout``.
+
+        A recorder is stopped last, once the others are gone, so that it takes their last
+        messages.
+        """
+        first = {n: p for n, p in self.procs.items() if n != "recorder"}
+        last = {n: p for n, p in self.procs.items() if n == "recorder"}
+        for group in (first, last):
+            for proc in group.values():
+                if proc.poll() is None:
+                    proc.send_signal(signal.SIGINT)
+            deadline = time.monotonic() + timeout
+            for proc in group.values():
+                try:
+                    proc.wait(max(0.0, deadline - time.monotonic()))
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                    proc.wait()
 
 
 def start_graph(
@@ -173,6 +186,7 @@ def start_graph(
         start=args.start,
         seed=args.seed,
         result_file=result_file,
+        bag=args.bag,
     )
     procs = [graph.start(node, spec.namespace) for node in spec.nodes]
     return procs[-1]  # the bridge, started last: it waits for the others anyway
@@ -232,7 +246,23 @@ def prepare(args: argparse.Namespace) -> tuple[Controller, Maze, str]:
     check_output_file(plot, "--plot", picture=True)
     if args.result:
         check_output_file(args.result, "--result")
+    if args.bag:
+        check_new_bag(args.bag)
     return controller, maze, plot
+
+
+def check_new_bag(path: str) -> None:
+    """Refuse a ``--bag`` folder that exists (or an unfinished one), before any node starts.
+
+    Raises:
+        ConfigError: one line naming ``--bag``.
+    """
+    from sim_bridge.rosbag_io import partial_path
+
+    for where in (Path(path), partial_path(path)):
+        if where.exists() or where.is_symlink():
+            raise ConfigError(f"--bag {path}: {where} exists; name a new folder")
+    check_output_file(path, "--bag")  # its folder can be written
 
 
 def main(argv=None) -> int:
@@ -305,6 +335,12 @@ def run(args: argparse.Namespace) -> int:
     verdict = episode_verdict(result)
     fitness = "" if result.get("interrupted") else f", fitness {result['fitness']:.3f}"
     print(f"{maze.name}: {verdict}{fitness} ({args.mode}) -> {plot}")
+    if args.bag:
+        recorder = graph.procs["recorder"].returncode
+        if recorder != 0:
+            print(f"evorbc-sim: error: the recorder failed (status {recorder})", file=sys.stderr)
+            return 1
+        print(f"recorded {args.bag} (evorbc-play {args.bag} --compare plays it back)")
     from sim_bridge.maze_plot import plot_run
 
     plot_run(

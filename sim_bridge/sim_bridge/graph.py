@@ -79,7 +79,27 @@ ARGUMENTS = (
         "",
         "namespace of every node and topic (e.g. robot1); /clock stays global",
     ),
+    Argument(
+        "bag",
+        "",
+        "record the run's topics into this new rosbag2 folder (MCAP storage); empty: none",
+    ),
 )
+
+#: What a recorded run holds (``bag``): topic -> message type. The robot's command topics
+#: are added, their types learnt from the graph.
+RECORDED = {
+    "/clock": "rosgraph_msgs/msg/Clock",
+    "scan": "sensor_msgs/msg/LaserScan",
+    "odom": "nav_msgs/msg/Odometry",
+    "goal": "geometry_msgs/msg/PointStamped",
+    "joint_states": "sensor_msgs/msg/JointState",
+    "evorbc/rangefinders": "std_msgs/msg/Float64MultiArray",
+    "evorbc/goal_sectors": "std_msgs/msg/Float64MultiArray",
+    "evorbc/primitive": "std_msgs/msg/Float64MultiArray",
+    "evorbc/mapping": "std_msgs/msg/Float64MultiArray",
+    "/diagnostics": "diagnostic_msgs/msg/DiagnosticArray",
+}
 
 
 @dataclass(frozen=True)
@@ -166,10 +186,13 @@ def sim_graph(
     result_file: str = "",
     record_file: str = "",
     paper: bool = False,
+    bag: str = "",
 ) -> SimGraph:
     """The graph that runs ``arbitrator`` (default: the one shipped for ``robot``) in a maze.
 
     ``paper`` picks the robot's shipped paper-protocol arbitrator instead of its default.
+    ``bag``: a recorder node, started first, records the run into this rosbag2 folder, and
+    the bridge holds its first state until the recorder hears every topic.
 
     Raises:
         ConfigError: an unknown robot or mode, or ``paper`` with ``arbitrator`` (one line
@@ -192,8 +215,23 @@ def sim_graph(
         given = _given(sim_time | params)
         return NodeSpec(name, "evorbc_ros", module, param_file(name), given, managed=managed)
 
+    commands = registry.lookup(robot).command_topics
+    recorder = NodeSpec(
+        "recorder",
+        "sim_bridge",
+        "sim_bridge.recorder",
+        param_file("recorder"),
+        {
+            "use_sim_time": True,
+            "bag": bag,
+            "topics": [*RECORDED, *commands],
+            "types": [*RECORDED.values(), *[""] * len(commands)],
+        },
+    )
+    ready = {"wait_for_ready": ["recorder/ready"]} if bag else {}
     return SimGraph(
         (
+            *([recorder] if bag else []),
             evorbc("laser_sensor", sensor_layout=arbitrator),
             evorbc("radar_sensor", sensor_layout=arbitrator),
             evorbc(
@@ -220,6 +258,7 @@ def sim_graph(
                         "seed": seed,
                         "result_file": result_file,
                         "episode_time": trained_episode_time(arbitrator) or "",
+                        **ready,
                     }
                 ),
                 required=True,
@@ -265,6 +304,7 @@ def graph_from_arguments(values: dict[str, str]) -> SimGraph:
             seed=seed,
             namespace=given["namespace"],
             paper=paper,
+            bag=given["bag"],
         )
     except ConfigError as e:
         raise ConfigError(f"argument {e}") from None

@@ -5,7 +5,9 @@ time t, ``/clock`` = t and a scan and an odometry stamped t; the arbitrator answ
 exactly one ``evorbc/primitive``. So the k-th scan, the k-th odometry and the k-th recorded
 choice belong to cycle k, and each pair is checked by its stamps. The episode's final state
 (published after the last step, for listeners) also draws a choice, which a recording
-stopped with the graph may miss: a bag holds one choice per cycle, or one fewer.
+stopped with the graph may miss: a bag holds one choice per cycle, or one fewer. When the
+graph stops, the arbitrator's deactivation sends one more, empty primitive (stop the
+robot): it belongs to no cycle and is left out.
 
 Pure data (rosbags and numpy): the ROS side is :mod:`sim_bridge.player`.
 """
@@ -112,6 +114,8 @@ def load_recording(path: str | os.PathLike, namespace: str = "") -> LockstepReco
             np.asarray(decode(raw, TYPES["primitive"], topics["primitive"]).data, np.float64)
             for raw in by_topic[topics["primitive"]]
         ]
+        while len(choices) > len(cycles) and choices[-1].size == 0:
+            choices.pop()  # the deactivation's stop, after the last cycle
     return LockstepRecording(topics, by_topic[topics["goal"]][0], cycles, choices)
 
 

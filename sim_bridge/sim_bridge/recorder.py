@@ -41,22 +41,24 @@ import time
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.event_handler import SubscriptionEventCallbacks
-from rclpy.exceptions import InvalidParameterTypeException
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Empty
 
+from evorbc_ros.health import WARN, Health
+from evorbc_ros.node_parameters import COMMON, spec
 from evorbc_ros.nodes.common import (
     LATCHED,
     Executor,
     StartupError,
-    declare,
     init_ros,
     logged_startup,
     quiet_teardown,
     spin_until_stopped,
     stop_requested,
 )
+from evorbc_ros.nodes.diagnostics import DiagnosticsPublisher
+from evorbc_ros.nodes.parameters import ParameterGuard, declare_all
 from sim_bridge.rosbag_io import BagError, BagWriter, check_type
 
 #: Messages each subscription may hold before the recorder takes them: a lockstep graph
@@ -97,23 +99,14 @@ def record_qos(latched: bool) -> QoSProfile:
     )
 
 
-def string_list(node: Node, name: str, description: str, default=None) -> list[str] | None:
-    """Declare a read-only string-array parameter; its value, or ``default`` if not given.
-
-    Raises:
-        StartupError: the override is not a list of strings.
-    """
-    from rcl_interfaces.msg import ParameterDescriptor
-    from rclpy.parameter import Parameter
-
-    descriptor = ParameterDescriptor(description=description, read_only=True)
-    try:
-        value = node.declare_parameter(name, Parameter.Type.STRING_ARRAY, descriptor).value
-    except InvalidParameterTypeException:
-        raise StartupError(
-            f"parameter {name} must be a list of strings, e.g. {name}:=[scan,odom]"
-        ) from None
-    return default if value is None else list(value)
+#: The recorder's parameters (:mod:`evorbc_ros.node_parameters`'s way).
+PARAMETERS = (
+    spec("bag", "", "bag folder to create (rosbag2, MCAP storage)"),
+    spec("topics", (), "topics to record"),
+    spec("types", (), "their message types (pkg/msg/Name), in order; empty: from the graph"),
+    spec("latched", ("goal",), "topics with a latched publisher (recorded transient local)"),
+    *COMMON,
+)
 
 
 class RecorderNode(Node):
@@ -122,14 +115,8 @@ class RecorderNode(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__("recorder", **kwargs)
         with logged_startup(self):
-            bag = declare(self, "bag", "", "bag folder to create (rosbag2, MCAP storage)")
-            topics = string_list(self, "topics", "topics to record")
-            types = string_list(
-                self, "types", "their message types (pkg/msg/Name); empty: from the graph", []
-            )
-            latched = string_list(
-                self, "latched", "topics with a latched publisher (transient local)", ["goal"]
-            )
+            p = declare_all(self, PARAMETERS, "at start-up", {})
+            bag, topics, types, latched = (p[k] for k in ("bag", "topics", "types", "latched"))
             if not bag:
                 raise StartupError("parameter bag must name the bag folder to create")
             if not topics:
@@ -150,6 +137,8 @@ class RecorderNode(Node):
                 self.bag = BagWriter(bag)
             except BagError as e:
                 raise StartupError(f"parameter bag: {e}") from None
+        ParameterGuard(self, PARAMETERS, "at start-up")
+        self.diagnostics = DiagnosticsPublisher(self, p["diagnostics_period"], self.health)
         self.subs = {}
         self.matched: set[str] = set()  # topics whose subscription has matched a publisher
         # Latched: a bridge that starts waiting after it was sent still gets it.
@@ -280,6 +269,16 @@ class RecorderNode(Node):
         counts = ", ".join(f"{t} {n}" for t, n in bag.counts.items())
         self.get_logger().info(f"wrote {path}: {counts or 'no topics'}")
         return True
+
+    def health(self, now: float) -> Health:
+        """Messages written, topics still without a publisher."""
+        h = Health()
+        h.add("messages written", self.written)
+        missing = sorted(set(self.wanted) - self.matched)
+        h.add("topics without a publisher", ", ".join(missing) or "none")
+        if missing:
+            h.worse(WARN, f"no publisher yet on {', '.join(missing)}")
+        return h
 
     def destroy_node(self) -> None:
         """Close the bag, then the node."""
