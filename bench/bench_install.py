@@ -23,6 +23,7 @@ from pathlib import Path
 
 import rclpy
 from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from std_msgs.msg import Float64MultiArray
 
@@ -53,6 +54,8 @@ def first_command(prefix_of, env, cwd, domain: int) -> float:
     context = Context()
     rclpy.init(context=context, domain_id=domain)
     probe = Node("bench_probe", context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(probe)
     got = []
     probe.create_subscription(
         Float64MultiArray, "wheel_velocity_controller/commands", got.append, 10
@@ -73,7 +76,7 @@ def first_command(prefix_of, env, cwd, domain: int) -> float:
     ]
     try:
         while not got and time.monotonic() - t0 < 300:
-            rclpy.spin_once(probe, timeout_sec=0.01)
+            executor.spin_once(timeout_sec=0.01)
         return time.monotonic() - t0
     finally:
         for p in procs:
