@@ -24,7 +24,7 @@ from evorbc_ros.nodes.common import StartupError, vector_message
 from evorbc_ros.nodes.laser_sensor import LaserSensorNode
 from evorbc_ros.nodes.primitive_executor import PrimitiveExecutorNode
 from evorbc_ros.nodes.radar_sensor import RadarSensorNode
-from sim_bridge import bridge_parameters
+from sim_bridge import bridge_parameters, recorder
 
 NODES = {
     "laser_sensor": LaserSensorNode,
@@ -32,7 +32,11 @@ NODES = {
     "arbitrator": ArbitratorNode,
     "primitive_executor": PrimitiveExecutorNode,
 }
-TABLES = {**PARAMETERS, "sim_bridge": bridge_parameters.PARAMETERS}
+TABLES = {
+    **PARAMETERS,
+    "sim_bridge": bridge_parameters.PARAMETERS,
+    "recorder": recorder.PARAMETERS,
+}
 #: rclpy's own parameters.
 RCLPY_PARAMETERS = {"use_sim_time", "start_type_description_service"}
 
@@ -55,7 +59,11 @@ def test_each_shipped_file_holds_valid_values_of_its_nodes_table(node):
         assert specs[name].problem(value) == "", name
     # The file shows every parameter a user may want to change (all but the bridge's
     # readiness lists, which evorbc-sim and the launch file fill in).
-    assert set(specs) - set(values) <= {"wait_for_subscribers", "wait_for_publishers"}
+    assert set(specs) - set(values) <= {
+        "wait_for_subscribers",
+        "wait_for_publishers",
+        "wait_for_ready",
+    }
 
 
 @pytest.mark.parametrize("namespace", ["", "robot1", "fleet/robot2"])
