@@ -19,7 +19,7 @@ setup(
     version=re.search(r"<version>(.*?)</version>", manifest).group(1),
     license=re.search(r"<license>(.*?)</license>", manifest).group(1),
     packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
-    package_data={PACKAGE: ["data/*.json", "settings/*/*"]},
+    package_data={PACKAGE: ["data/*.json", "data/*.md", "settings/**/*"]},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),

@@ -73,7 +73,12 @@ def _nodes(context):
 
 
 def _drive(node, name):
-    """Configure ``node`` now; activate it once configured; fail the launch if it cannot."""
+    """Configure ``node`` now; activate it once configured; fail the launch if it cannot.
+
+    The activation is handled once: after a later reconfigure by hand (``ros2 lifecycle``)
+    the user activates the node. A failed configure, or an error in a transition (which
+    ends in unconfigured through errorprocessing), fails the launch whenever it happens.
+    """
 
     def change(transition):
         return EmitEvent(
@@ -81,7 +86,7 @@ def _drive(node, name):
         )
 
     def refused(context):
-        raise GraphFailed(f"{name} could not be configured (its line above says why)")
+        raise GraphFailed(f"{name} could not be configured or failed (its line above says why)")
 
     return [
         RegisterEventHandler(
@@ -90,15 +95,19 @@ def _drive(node, name):
                 start_state="configuring",
                 goal_state="inactive",
                 entities=[change(Transition.TRANSITION_ACTIVATE)],
+                handle_once=True,
             )
         ),
-        RegisterEventHandler(
-            OnStateTransition(
-                target_lifecycle_node=node,
-                start_state="configuring",
-                goal_state="unconfigured",
-                entities=[OpaqueFunction(function=refused)],
+        *(
+            RegisterEventHandler(
+                OnStateTransition(
+                    target_lifecycle_node=node,
+                    start_state=start,
+                    goal_state="unconfigured",
+                    entities=[OpaqueFunction(function=refused)],
+                )
             )
+            for start in ("configuring", "errorprocessing")
         ),
         change(Transition.TRANSITION_CONFIGURE),
     ]

@@ -63,10 +63,18 @@ def statuses(ros, name):
     return lambda: [s for msg in got for s in msg.status if s.name == f"/{name}"]
 
 
-def next_status(ros, seen):
-    """The next status published after now."""
-    count = len(seen())
-    assert ros.spin_until(lambda: len(seen()) > count, timeout=5.0)
+def latest_is(ros, seen, level, message=None):
+    """Wait until the latest status has ``level`` (and ``message``); return it.
+
+    A status computed before the change it should show may still be on its way, so the
+    tests wait for the state rather than take the next message.
+    """
+
+    def ok():
+        s = seen()
+        return bool(s) and s[-1].level == level and message in (None, s[-1].message)
+
+    assert ros.spin_until(ok, timeout=5.0), seen()[-1:] if seen() else "no status"
     return seen()[-1]
 
 
@@ -89,14 +97,12 @@ def test_the_laser_node_reports_its_scans(ros):
     seen = statuses(ros, "laser_sensor")
     pub = ros.publisher(LaserScan, "scan")
     ros.connected(pub)
-    assert next_status(ros, seen).level == DiagnosticStatus.WARN  # no scan yet
+    latest_is(ros, seen, DiagnosticStatus.WARN, "no scan yet")
     pub.publish(scan())
-    assert ros.spin_until(lambda: values(seen()[-1]).get("scan age (s)") == "0.000")
-    status = next_status(ros, seen)
-    assert status.level == DiagnosticStatus.OK and status.message == "ok"
+    status = latest_is(ros, seen, DiagnosticStatus.OK, "ok")
+    assert values(status)["scan age (s)"] == "0.000"
     ros.set_clock(3.0)  # two seconds without a scan
-    status = next_status(ros, seen)
-    assert status.level == DiagnosticStatus.WARN and status.message == "scan is 2.00 s old"
+    latest_is(ros, seen, DiagnosticStatus.WARN, "scan is 2.00 s old")
     pub.publish(scan(0))  # a 0-beam scan: skipped, and said
     assert ros.spin_until(lambda: seen()[-1].message == "1 scan message(s) skipped")
 
@@ -129,8 +135,8 @@ def test_the_executor_reports_a_stale_stop_and_refused_primitives(ros):
     gs.publish(vector_message([1, 0, 0, 0]))
     prim.publish(vector_message([1.0, 0, 0, 0, 0]))
     assert ros.spin_until(lambda: node.primitive_seen)
-    status = next_status(ros, seen)
-    assert status.level == DiagnosticStatus.OK and values(status)["robot"] == "running"
+    status = latest_is(ros, seen, DiagnosticStatus.OK)
+    assert values(status)["robot"] == "running"
     assert values(status)["state"] == "active" and status.hardware_id == "4ws-5"
     ros.set_clock(2.0)  # every input is now 1 s old: the stale stop
     assert ros.spin_until(lambda: values(seen()[-1])["robot"].startswith("stopped"))
@@ -145,15 +151,11 @@ def test_the_arbitrator_reports_its_state_and_choices(ros, tmp_path):
     ros.make(ArbitratorNode, autostart=False, arbitrator=str(tmp_path / "no.json"), **FAST)
     ros.set_clock(1.0)
     seen = statuses(ros, "arbitrator")
-    status = next_status(ros, seen)
-    assert (
-        status.level == DiagnosticStatus.WARN and status.message == "unconfigured: not commanding"
-    )
+    latest_is(ros, seen, DiagnosticStatus.WARN, "unconfigured: not commanding")
     node = ros.nodes[-1]
     node.trigger_configure()
-    status = next_status(ros, seen)
-    assert status.level == DiagnosticStatus.ERROR
-    assert status.message == f"cannot configure: {tmp_path / 'no.json'}: no such arbitrator file"
+    failed = f"cannot configure: {tmp_path / 'no.json'}: no such arbitrator file"
+    latest_is(ros, seen, DiagnosticStatus.ERROR, failed)
     genes = ros.listen(Float64MultiArray, "evorbc/primitive")
     from rclpy.parameter import Parameter
 
@@ -164,7 +166,6 @@ def test_the_arbitrator_reports_its_state_and_choices(ros, tmp_path):
     rf.publish(vector_message([0.0] * 8))
     gs.publish(vector_message([1.0] + [0.0] * 8))
     assert ros.spin_until(lambda: len(genes) == 1)
-    status = next_status(ros, seen)
-    assert status.level == DiagnosticStatus.OK, status.message
+    status = latest_is(ros, seen, DiagnosticStatus.OK)
     assert values(status)["state"] == "active"
     assert values(status)["last choice"].startswith("[")

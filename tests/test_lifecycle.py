@@ -5,16 +5,27 @@ meanwhile), deactivate stops the robot, cleanup releases; ``autostart`` (default
 configure and activate at start-up, and a failed configure is then the one FATAL line.
 """
 
+import os
+import signal
+import subprocess
+import sys
+import time
+
 import numpy as np
 import pytest
+import rclpy
+from graph_helpers import graph_env
 from lifecycle_msgs.msg import State
 from lifecycle_msgs.srv import ChangeState, GetState
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.lifecycle import TransitionCallbackReturn
+from rclpy.node import Node
 from std_msgs.msg import Float64MultiArray
 
 from evorbc_ros.defaults import default_arbitrator
 from evorbc_ros.nodes.arbitrator import ArbitratorNode
-from evorbc_ros.nodes.common import StartupError, vector_message
+from evorbc_ros.nodes.common import RELIABLE, StartupError, vector_message
 from evorbc_ros.nodes.primitive_executor import PrimitiveExecutorNode
 
 SUCCESS, FAILURE = TransitionCallbackReturn.SUCCESS, TransitionCallbackReturn.FAILURE
@@ -73,8 +84,10 @@ def test_activation_chooses_at_once_from_readings_that_came_while_inactive(ros):
 
 
 def test_deactivation_stops_the_robot_and_then_nothing_is_sent(ros):
-    arbitrator = ros.make(ArbitratorNode)
-    executor = ros.make(PrimitiveExecutorNode)
+    # Simulated time that stands still: no keep-alive command, no stale stop, under any load.
+    arbitrator = ros.make(ArbitratorNode, sim_time=True)
+    executor = ros.make(PrimitiveExecutorNode, sim_time=True)
+    ros.set_clock(1.0)
     genes = ros.listen(Float64MultiArray, "evorbc/primitive")
     wheels = ros.listen(Float64MultiArray, "wheel_velocity_controller/commands")
     rf, gs = ros.arbitrator_inputs()
@@ -134,7 +147,8 @@ def test_ros2_lifecycle_sees_the_nodes_through_their_services(ros):
 
 
 def test_an_active_executor_commands_a_primitive_that_came_while_inactive(ros):
-    executor = ros.make(PrimitiveExecutorNode, autostart=False)
+    executor = ros.make(PrimitiveExecutorNode, sim_time=True, autostart=False)
+    ros.set_clock(1.0)  # and it stands still: the primitive cannot go stale meanwhile
     executor.trigger_configure()
     wheels = ros.listen(Float64MultiArray, "wheel_velocity_controller/commands")
     prim, rf, gs = ros.executor_inputs()
@@ -146,3 +160,66 @@ def test_an_active_executor_commands_a_primitive_that_came_while_inactive(ros):
     assert executor.trigger_activate() == SUCCESS
     assert ros.spin_until(lambda: len(wheels) == 1)
     np.testing.assert_allclose(wheels[0].data, [0.2 / 0.02] * 4)
+
+
+def test_ctrl_c_stops_the_robot_before_the_executor_exits(tmp_path):
+    """The last command of an executor process stopped by SIGINT is the stop (zero speed)."""
+    domain = 185
+    proc = subprocess.Popen(
+        [sys.executable, "-P", "-m", "evorbc_ros.nodes.primitive_executor"],
+        env=graph_env(domain),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    context = Context()
+    rclpy.init(context=context, domain_id=domain)
+    try:
+        node = Node("ctrl_c_probe", context=context)
+        spin = SingleThreadedExecutor(context=context)
+        spin.add_node(node)
+        wheels = []
+        node.create_subscription(
+            Float64MultiArray, "wheel_velocity_controller/commands", wheels.append, RELIABLE
+        )
+        pubs = [
+            node.create_publisher(Float64MultiArray, t, RELIABLE)
+            for t in ("evorbc/rangefinders", "evorbc/goal_sectors", "evorbc/primitive")
+        ]
+        deadline = time.monotonic() + 60
+        while (not wheels or wheels[-1].data[0] == 0.0) and time.monotonic() < deadline:
+            if proc.poll() is not None:
+                break
+            pubs[0].publish(vector_message([0.0] * 6))
+            pubs[1].publish(vector_message([1, 0, 0, 0]))
+            pubs[2].publish(vector_message([1.0, 0, 0, 0, 0]))  # full speed
+            spin.spin_once(timeout_sec=0.05)
+        assert wheels and wheels[-1].data[0] > 0.0, proc.poll()
+        sent = len(wheels)
+        os.kill(proc.pid, signal.SIGINT)
+        while proc.poll() is None and time.monotonic() < deadline:
+            spin.spin_once(timeout_sec=0.05)
+        for _ in range(20):  # what is still on its way
+            spin.spin_once(timeout_sec=0.05)
+        out = proc.communicate(timeout=30)[0]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        context.try_shutdown()
+    assert proc.returncode == 0, out
+    assert len(wheels) > sent and list(wheels[-1].data) == [0.0] * 4
+    assert "deactivated: robot stopped" in out
+
+
+def test_an_unexpected_error_in_a_transition_is_said_and_fails_it(ros, monkeypatch):
+    def broken(self, *args):
+        raise RuntimeError("boom")
+
+    node = ros.make(ArbitratorNode, autostart=False)
+    node.trigger_configure()
+    monkeypatch.setattr(ArbitratorNode, "activate", broken)
+    assert node.trigger_activate() == FAILURE
+    assert node.state == "inactive" and node.configure_error == "RuntimeError: boom"
+    monkeypatch.setattr(ArbitratorNode, "configure", broken)
+    with pytest.raises(StartupError, match="RuntimeError: boom"):
+        ros.make(ArbitratorNode)  # autostart: the one FATAL start-up line says it

@@ -96,7 +96,7 @@ def test_the_laser_node_draws_its_rangefinder_rays(ros):
 
 
 def test_the_radar_node_draws_the_lit_sector(ros):
-    ros.make(RadarSensorNode, markers=True)
+    node = ros.make(RadarSensorNode, markers=True)
     got = marker_arrays(ros, "radar_sensor")
     odom = ros.publisher(Odometry, "odom")
     goal = ros.publisher(PointStamped, "goal", LATCHED)
@@ -104,7 +104,7 @@ def test_the_radar_node_draws_the_lit_sector(ros):
     target = PointStamped()
     target.point.x = 3.0  # straight ahead
     goal.publish(target)
-    ros.spin_until(lambda: False, timeout=0.1)
+    assert ros.spin_until(lambda: node.goal is not None)
     pose = Odometry()
     pose.pose.pose.orientation.w = 1.0
     odom.publish(pose)

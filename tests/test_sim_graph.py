@@ -262,12 +262,14 @@ def test_the_launch_file_configures_then_activates_the_lifecycle_nodes(monkeypat
             for a in actions
             if a.args and a.args[0].kwargs.get("target_lifecycle_node") is node
         ]
-        on = {(h["start_state"], h["goal_state"]): h["entities"] for h in handlers}
-        (activate,) = on["configuring", "inactive"]
+        on = {(h["start_state"], h["goal_state"]): h for h in handlers}
+        (activate,) = on["configuring", "inactive"]["entities"]
         assert activate.kwargs["event"].kwargs["transition_id"] == Transition.TRANSITION_ACTIVATE
-        (refused,) = on["configuring", "unconfigured"]
-        with pytest.raises(RuntimeError, match="could not be configured"):
-            refused.kwargs["function"](None)
+        assert on["configuring", "inactive"]["handle_once"]  # not after a manual reconfigure
+        for start in ("configuring", "errorprocessing"):
+            (refused,) = on[start, "unconfigured"]["entities"]
+            with pytest.raises(RuntimeError, match="could not be configured"):
+                refused.kwargs["function"](None)
 
 
 def test_evorbc_sim_starts_the_same_graph_with_the_parameter_files(monkeypatch):

@@ -16,7 +16,8 @@ BURGER = "turtlebot3-burger"
 
 @pytest.mark.parametrize(("stamped", "kind"), [(True, TwistStamped), (False, Twist)])
 def test_the_executor_publishes_the_twist_type_asked_for(ros, stamped, kind):
-    ros.make(PrimitiveExecutorNode, robot=BURGER, twist_stamped=stamped)
+    ros.make(PrimitiveExecutorNode, sim_time=True, robot=BURGER, twist_stamped=stamped)
+    ros.set_clock(1.0)  # standing still: no stale stop under load
     got = ros.listen(kind, "cmd_vel")
     prim, rf, gs = ros.executor_inputs()
     rf.publish(vector_message([0.0] * 6))

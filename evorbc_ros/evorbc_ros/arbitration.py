@@ -15,6 +15,10 @@ from evorbc_ros.laser import InputError
 from evorbc_ros.mapping import NO_PRIMITIVE
 from evorbc_ros.repertoire import Repertoire
 
+#: The label of the empty primitive an arbitrator sends when it is deactivated (stop the
+#: robot), which tells it from a cycle's "no primitive" (docs/design.md section 9).
+DEACTIVATED = "deactivated"
+
 
 class InputGroups:
     """The latest values of each input group and whether all are new."""

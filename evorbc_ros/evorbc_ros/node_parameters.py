@@ -249,9 +249,12 @@ REMOVED: dict[str, dict[str, str]] = {
 }
 
 
-def removed_problem(node: str, given: set[str], removed: dict[str, dict[str, str]]) -> str:
-    """One line for the first removed parameter in ``given``; "" if none is there."""
-    for name, topic in removed.get(node, {}).items():
+def removed_problem(given: set[str], removed: dict[str, str]) -> str:
+    """One line for the first removed parameter in ``given``; "" if none is there.
+
+    ``removed``: a node's entry of :data:`REMOVED` (parameter -> the topic to remap).
+    """
+    for name, topic in removed.items():
         if name in given:
             first = topic.split(" ")[0]
             return (

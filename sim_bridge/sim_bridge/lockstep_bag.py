@@ -6,8 +6,8 @@ exactly one ``evorbc/primitive``. So the k-th scan, the k-th odometry and the k-
 choice belong to cycle k, and each pair is checked by its stamps. The episode's final state
 (published after the last step, for listeners) also draws a choice, which a recording
 stopped with the graph may miss: a bag holds one choice per cycle, or one fewer. When the
-graph stops, the arbitrator's deactivation sends one more, empty primitive (stop the
-robot): it belongs to no cycle and is left out.
+graph stops, the arbitrator's deactivation sends one more, empty primitive labelled
+``deactivated`` (stop the robot): it belongs to no cycle and is left out.
 
 Pure data (rosbags and numpy): the ROS side is :mod:`sim_bridge.player`.
 """
@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from evorbc_ros.arbitration import DEACTIVATED
 from sim_bridge.rosbag_io import BagError, BagReader, decode
 
 #: What each role's topic must carry.
@@ -110,13 +111,17 @@ def load_recording(path: str | os.PathLike, namespace: str = "") -> LockstepReco
         raise BagError(f"{path}: {topics['scan']} has no message")
     choices = None
     if topics["primitive"] in bag.topics:
-        choices = [
-            np.asarray(decode(raw, TYPES["primitive"], topics["primitive"]).data, np.float64)
+        messages = [
+            decode(raw, TYPES["primitive"], topics["primitive"])
             for raw in by_topic[topics["primitive"]]
         ]
-        while len(choices) > len(cycles) and choices[-1].size == 0:
-            choices.pop()  # the deactivation's stop, after the last cycle
+        choices = [np.asarray(m.data, np.float64) for m in messages if not _deactivation(m)]
     return LockstepRecording(topics, by_topic[topics["goal"]][0], cycles, choices)
+
+
+def _deactivation(msg) -> bool:
+    """Whether a primitive message is the arbitrator's deactivation (empty, labelled so)."""
+    return len(msg.data) == 0 and bool(msg.layout.dim) and msg.layout.dim[0].label == DEACTIVATED
 
 
 def pair_cycles(

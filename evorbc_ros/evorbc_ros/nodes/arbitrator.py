@@ -28,13 +28,12 @@ from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Empty
 from visualization_msgs.msg import MarkerArray
 
-from evorbc_ros.arbitration import Controller, InputGroups
+from evorbc_ros.arbitration import DEACTIVATED, Controller, InputGroups
 from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, ships_controller
 from evorbc_ros.health import ERROR, WARN, Health, Meter, report_input, report_skipped
 from evorbc_ros.laser import InputError
 from evorbc_ros.marker_geometry import primitive_arrows
-from evorbc_ros.node_parameters import PARAMETERS
 from evorbc_ros.nodes.common import (
     DIAGNOSTICS,
     StartupError,
@@ -58,7 +57,7 @@ STALE = 0.3
 class ArbitratorNode(ManagedNode):
     """Chooses a primitive whenever a full set of new readings has arrived."""
 
-    SPECS = PARAMETERS["arbitrator"]
+    NAME = "arbitrator"
 
     def __init__(self, **kwargs) -> None:
         self.controller: Controller | None = None
@@ -69,7 +68,7 @@ class ArbitratorNode(ManagedNode):
         self.meters = {t: Meter() for t in INPUTS}
         self.skipped, self.choices, self.halts, self.failures = Meter(), Meter(), Meter(), Meter()
         self.last_choice: list[float] = []
-        super().__init__("arbitrator", **kwargs)
+        super().__init__(**kwargs)
         self.reset_service = self.create_service(Empty, "~/reset", self.on_reset)
 
     # -- lifecycle ----------------------------------------------------------------------
@@ -122,8 +121,12 @@ class ArbitratorNode(ManagedNode):
             self.choose()
 
     def deactivate(self) -> None:
-        """An empty primitive: the executor stops the robot at once."""
-        self.pub.publish(vector_message([]))
+        """An empty primitive: the executor stops the robot at once.
+
+        Labelled ``deactivated`` (the label of a choice is its genes' names), so that a
+        recording tells it from a cycle's "no primitive".
+        """
+        self.pub.publish(vector_message([], [DEACTIVATED]))
         self.get_logger().info("deactivated: sent no primitive (the robot stops)")
 
     def release(self) -> None:

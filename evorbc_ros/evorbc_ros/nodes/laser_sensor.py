@@ -21,7 +21,7 @@ from std_msgs.msg import Float64MultiArray
 from evorbc_ros.health import WARN, Health, Meter, report_input, report_skipped
 from evorbc_ros.laser import Coverage, InputError, LaserPose, LaserToRangefinders
 from evorbc_ros.marker_geometry import rangefinder_rays, reading_colour
-from evorbc_ros.node_parameters import PARAMETERS
+from evorbc_ros.node_parameters import PARAMETERS, REMOVED
 from evorbc_ros.nodes.common import (
     RELIABLE,
     SENSOR_DATA,
@@ -47,7 +47,7 @@ class LaserSensorNode(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__("laser_sensor", **kwargs)
         with logged_startup(self):
-            p = declare_all(self, SPECS, "at start-up")
+            p = declare_all(self, SPECS, "at start-up", REMOVED["laser_sensor"])
             layout = load_sensor_layout(p["sensor_layout"])
             if layout.rangefinders is None:
                 raise StartupError("parameter sensor_layout: the layout has no rangefinders")

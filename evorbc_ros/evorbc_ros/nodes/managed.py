@@ -17,53 +17,57 @@ lifecycle set`` or a launch file drives the transitions (docs/design.md section 
 
 from __future__ import annotations
 
+from rclpy.duration import Duration
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 
 from evorbc_ros.health import ERROR, WARN, Health
-from evorbc_ros.node_parameters import ParamSpec
+from evorbc_ros.node_parameters import PARAMETERS, REMOVED, ParamSpec
 from evorbc_ros.nodes.common import RELIABLE, StartupError, logged_startup
 from evorbc_ros.nodes.diagnostics import DiagnosticsPublisher
 from evorbc_ros.nodes.parameters import ParameterGuard, declare_all
 
 SUCCESS, FAILURE = TransitionCallbackReturn.SUCCESS, TransitionCallbackReturn.FAILURE
+#: s to wait, at the end of the process, for the subscribers to acknowledge the last
+#: (stop) messages before the publishers go.
+LAST_WORDS = 0.5
 
 
 class ManagedNode(LifecycleNode):
     """A lifecycle node that reads its table of parameters at configure.
 
-    Subclasses set :attr:`SPECS` and implement :meth:`configure` (load, check, create
-    publishers and subscriptions; raise :class:`StartupError`), :meth:`activate`,
-    :meth:`deactivate` (stop the robot), :meth:`release` (undo :meth:`configure`, safe to
-    call twice) and :meth:`report` (their part of the health report).
+    Subclasses set :attr:`NAME` (the node's name, and the key of its parameter table and
+    removed parameters, whatever it is renamed to) and implement :meth:`configure` (load,
+    check, create publishers and subscriptions; raise :class:`StartupError`),
+    :meth:`activate`, :meth:`deactivate` (stop the robot), :meth:`release` (undo
+    :meth:`configure`, safe to call twice) and :meth:`report` (their part of the health
+    report).
     """
 
-    SPECS: tuple[ParamSpec, ...] = ()
+    NAME = ""
 
-    def __init__(self, name: str, hardware_id: str = "", **kwargs) -> None:
-        super().__init__(name, **kwargs)
+    def __init__(self, **kwargs) -> None:
+        super().__init__(self.NAME, **kwargs)
+        self.specs: tuple[ParamSpec, ...] = PARAMETERS[self.NAME]
         self.made: list = []  # publishers, subscriptions and timers configure made
         self.state = "unconfigured"
-        self.configure_error = ""  # why the last configure failed
+        self.configure_error = ""  # why the last configure (or activate) failed
         self._quiet_failure = False  # autostart reports it as the FATAL start-up line
         with logged_startup(self):
-            start = declare_all(self, self.SPECS, "at configure")
+            start = declare_all(self, self.specs, "at configure", REMOVED[self.NAME])
         ParameterGuard(
             self,
-            self.SPECS,
+            self.specs,
             "at configure",
             is_open=lambda: self.state == "unconfigured",
             apply=self.apply_live,
         )
-        self.diagnostics = DiagnosticsPublisher(
-            self, start["diagnostics_period"], self.health, hardware_id
-        )
+        self.diagnostics = DiagnosticsPublisher(self, start["diagnostics_period"], self.health)
         if start["autostart"]:
             with logged_startup(self):
                 self._quiet_failure = True
-                if self.trigger_configure() != SUCCESS:
+                if self.trigger_configure() != SUCCESS or self.trigger_activate() != SUCCESS:
                     raise StartupError(self.configure_error)
                 self._quiet_failure = False
-                self.trigger_activate()
 
     # -- what subclasses do -------------------------------------------------------------
 
@@ -123,7 +127,14 @@ class ManagedNode(LifecycleNode):
 
     def parameters(self) -> dict:
         """Every parameter of the table, checked, by name (their values now)."""
-        return {s.name: s.value(self.get_parameter(s.name).value) for s in self.SPECS}
+        return {s.name: s.value(self.get_parameter(s.name).value) for s in self.specs}
+
+    def _failed(self, step: str, error: Exception) -> None:
+        """Note why ``step`` failed, and log it unless autostart reports it."""
+        expected = isinstance(error, (StartupError, ValueError))
+        self.configure_error = str(error) if expected else f"{type(error).__name__}: {error}"
+        if not self._quiet_failure:
+            self.get_logger().error(f"cannot {step}: {self.configure_error}")
 
     def health(self, now: float) -> Health:
         """The lifecycle state and the subclass's report."""
@@ -139,53 +150,77 @@ class ManagedNode(LifecycleNode):
 
     # -- transitions --------------------------------------------------------------------
 
+    # Every transition catches what its step raises: rclpy would turn it into an error
+    # transition without a word, and the node would fall back to unconfigured unexplained.
+
     def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
         """Read the parameters and load the files; FAILURE (unconfigured) on a bad one."""
         try:
             self.configure(self.parameters())
-        except (StartupError, ValueError) as e:
+        except Exception as e:
+            self._failed("configure", e)
             self.release()
-            self.configure_error = str(e)
-            if not self._quiet_failure:
-                self.get_logger().error(f"cannot configure: {e}")
             return FAILURE
         self.configure_error = ""
         self.state = "inactive"
         return SUCCESS
 
     def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
-        """Enable the publishers, then act on what is held."""
+        """Enable the publishers, then act on what is held; FAILURE (inactive) if it fails."""
         super().on_activate(state)
         self.state = "active"
-        self.activate()
+        try:
+            self.activate()
+        except Exception as e:
+            self._failed("activate", e)
+            super().on_deactivate(state)
+            self.state = "inactive"
+            return FAILURE
         return SUCCESS
 
     def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
         """Stop the robot, then disable the publishers."""
-        self.deactivate()
+        self._stop_robot()
         super().on_deactivate(state)
         self.state = "inactive"
         return SUCCESS
 
     def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
         """Release what configure made."""
-        self.release()
+        self._release()
         self.state = "unconfigured"
         return SUCCESS
 
     def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
-        """Stop the robot if commanding, and release everything."""
+        """Stop the robot if commanding (and let the stop arrive), release everything."""
         if self.active:
-            self.deactivate()
-        self.release()
+            self._stop_robot()
+            for pub in self.made:
+                if hasattr(pub, "wait_for_all_acked"):
+                    pub.wait_for_all_acked(Duration(seconds=LAST_WORDS))
+        self._release()
         self.state = "finalized"
         return SUCCESS
 
     def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
-        """A transition raised: release and go back to unconfigured."""
-        self.release()
+        """A transition failed unexpectedly: release and go back to unconfigured."""
+        self._release()
         self.state = "unconfigured"
         return SUCCESS
+
+    def _stop_robot(self) -> None:
+        """:meth:`deactivate`, logged if it fails (the node goes on deactivating)."""
+        try:
+            self.deactivate()
+        except Exception as e:
+            self.get_logger().error(f"stopping the robot failed: {type(e).__name__}: {e}")
+
+    def _release(self) -> None:
+        """:meth:`release`, logged if it fails."""
+        try:
+            self.release()
+        except Exception as e:
+            self.get_logger().error(f"releasing failed: {type(e).__name__}: {e}")
 
     def finish(self) -> None:
         """At the end of the process: stop the robot if active (Ctrl-C stops it too)."""

@@ -18,6 +18,9 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from evorbc_ros.nodes.common import RELIABLE
 
+#: s a marker stays shown without an update.
+LIFETIME = 1
+
 
 class Markers:
     """A node's marker publisher on ``~/markers``.
@@ -54,6 +57,9 @@ def _point(xy) -> Point:
 
 def _marker(ns: str, kind: int, rgba: Sequence[float], scale: Sequence[float]) -> Marker:
     m = Marker(ns=ns, id=0, type=kind, action=Marker.ADD)
+    # Gone a second after the last update: a stopped or deactivated node leaves no stale
+    # target or rays behind in RViz.
+    m.lifetime.sec = LIFETIME
     m.pose.orientation.w = 1.0
     m.scale.x, m.scale.y, m.scale.z = (float(v) for v in scale)
     m.color = ColorRGBA(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3])

@@ -25,7 +25,7 @@ from rcl_interfaces.msg import (
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from evorbc_ros.node_parameters import INT64_MAX, REMOVED, ParamSpec, removed_problem
+from evorbc_ros.node_parameters import INT64_MAX, ParamSpec, removed_problem
 from evorbc_ros.nodes.common import StartupError
 
 
@@ -67,22 +67,22 @@ def given_parameters(node: Node) -> set[str]:
 
 
 def declare_all(
-    node: Node, specs: Iterable[ParamSpec], read_when: str, removed: dict | None = None
+    node: Node, specs: Iterable[ParamSpec], read_when: str, removed: dict[str, str]
 ) -> dict:
     """Declare ``specs`` on ``node`` and return their checked values by name.
 
     Args:
         read_when: "at start-up" or "at configure" (the descriptors say it).
-        removed: the node's removed parameters -> their remapping (default: the evorbc
-            node of this name's, :data:`~evorbc_ros.node_parameters.REMOVED`).
+        removed: the node's removed parameters -> their remapping
+            (:data:`~evorbc_ros.node_parameters.REMOVED`); by the node's kind, not its
+            name, which a user may change (``-r __node:=left_arbitrator``).
 
     Raises:
         StartupError: one line naming a removed parameter and its remapping, or a value
             of the wrong type or out of range.
 
     """
-    table = {node.get_name(): removed} if removed is not None else REMOVED
-    problem = removed_problem(node.get_name(), given_parameters(node), table)
+    problem = removed_problem(given_parameters(node), removed)
     if problem:
         raise StartupError(problem)
     values = {}
@@ -96,7 +96,7 @@ def declare_all(
                 node.set_parameters([Parameter(spec.name, Parameter.Type.STRING_ARRAY, [])])
                 raw = []
         except Exception as e:  # rclpy: another type, or out of the descriptor's range
-            given = node._parameter_overrides.get(spec.name)
+            given = getattr(node, "_parameter_overrides", {}).get(spec.name)
             problem = spec.problem(given.value) if given is not None else ""
             raise StartupError(problem or f"parameter {spec.name}: {e}") from None
         try:
@@ -133,6 +133,9 @@ class ParameterGuard:
         self.is_open = is_open or (lambda: False)
         self.apply = apply
         node.add_on_set_parameters_callback(self.on_set)
+        # Applied once rclpy has taken the new values, so what the node uses is always what
+        # ros2 param get shows, whatever other callback might still refuse the change.
+        node.add_post_set_parameters_callback(self.after_set)
 
     def on_set(self, params: list[Parameter]) -> SetParametersResult:
         """Accept a valid value of a live or an open parameter, or the value it has."""
@@ -155,12 +158,16 @@ class ParameterGuard:
             return SetParametersResult(
                 successful=False, reason=f"parameter {p.name} is read {when}: {how}"
             )
-        if self.apply is not None:
-            for p in params:
-                spec = self.specs.get(p.name)
-                if spec is not None and spec.live:
-                    self.apply(p.name, spec.value(p.value))
         return SetParametersResult(successful=True)
+
+    def after_set(self, params: list[Parameter]) -> None:
+        """Apply the live parameters just set."""
+        if self.apply is None:
+            return
+        for p in params:
+            spec = self.specs.get(p.name)
+            if spec is not None and spec.live:
+                self.apply(p.name, spec.value(p.value))
 
 
 def _same(a, b) -> bool:

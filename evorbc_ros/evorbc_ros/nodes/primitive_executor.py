@@ -44,7 +44,6 @@ from std_msgs.msg import Float64MultiArray
 from evorbc_ros.executor import NO_PRIMITIVE_REASON
 from evorbc_ros.health import ERROR, WARN, Health, Meter, report_input, report_skipped
 from evorbc_ros.laser import InputError
-from evorbc_ros.node_parameters import PARAMETERS
 from evorbc_ros.nodes.common import StartupError, now_seconds, robot_named, run_node
 from evorbc_ros.nodes.managed import ManagedNode
 from evorbc_ros.robots import registry
@@ -57,7 +56,7 @@ DEACTIVATED = "the executor was deactivated"
 class PrimitiveExecutorNode(ManagedNode):
     """Publishes commands at 10 Hz and stops the robot when inputs go stale."""
 
-    SPECS = PARAMETERS["primitive_executor"]
+    NAME = "primitive_executor"
 
     def __init__(self, **kwargs) -> None:
         self.spec = None
@@ -65,7 +64,7 @@ class PrimitiveExecutorNode(ManagedNode):
         self.wheel_radius = 0.0
         self.primitive, self.sent, self.skipped, self.refused = Meter(), Meter(), Meter(), Meter()
         self.inputs: dict[str, Meter] = {}
-        super().__init__("primitive_executor", **kwargs)
+        super().__init__(**kwargs)
 
     # -- lifecycle ----------------------------------------------------------------------
 

@@ -33,7 +33,7 @@ from evorbc_ros.goal import GoalInputs, yaw_from_quaternion
 from evorbc_ros.health import WARN, Health, Meter, report_input, report_skipped
 from evorbc_ros.laser import InputError
 from evorbc_ros.marker_geometry import bearing_arrow, sector_wedges
-from evorbc_ros.node_parameters import PARAMETERS
+from evorbc_ros.node_parameters import PARAMETERS, REMOVED
 from evorbc_ros.nodes.common import (
     LATCHED,
     RELIABLE,
@@ -62,7 +62,7 @@ class RadarSensorNode(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__("radar_sensor", **kwargs)
         with logged_startup(self):
-            p = declare_all(self, SPECS, "at start-up")
+            p = declare_all(self, SPECS, "at start-up", REMOVED["radar_sensor"])
             self.layout = load_sensor_layout(p["sensor_layout"])
             try:
                 self.inputs = GoalInputs(self.layout)
