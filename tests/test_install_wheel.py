@@ -15,6 +15,7 @@ import signal
 import subprocess
 import sys
 import tarfile
+import time
 import zipfile
 from pathlib import Path
 
@@ -214,6 +215,15 @@ def test_ros2_lifecycle_param_and_diagnostics_from_the_wheel(venv, tmp_path):
     def ros2(*args):
         return run(["ros2", *args], env, tmp_path, timeout=120, check=False)
 
+    def until(check, *args):
+        """``ros2 ARGS`` until ``check(output)``: the CLI may not see a new node at once."""
+        deadline = time.monotonic() + 60
+        done = ros2(*args)
+        while not check(done.stdout) and time.monotonic() < deadline:
+            done = ros2(*args)
+        assert check(done.stdout), done.stdout + done.stderr
+        return done
+
     node = subprocess.Popen(
         ["ros2", "run", "evorbc_ros", "arbitrator"],
         env=env,
@@ -225,15 +235,21 @@ def test_ros2_lifecycle_param_and_diagnostics_from_the_wheel(venv, tmp_path):
     )
     try:
         wait_for_node("arbitrator", 193, node)
-        assert ros2("lifecycle", "get", "/arbitrator").stdout.strip() == "active [3]"
-        described = ros2("param", "describe", "/arbitrator", "diagnostics_period").stdout
-        assert "Min value: 0.1" in described and "Max value: 60.0" in described
+        until(lambda out: out.strip() == "active [3]", "lifecycle", "get", "/arbitrator")
+        described = until(
+            lambda out: "Min value: 0.1" in out,
+            "param",
+            "describe",
+            "/arbitrator",
+            "diagnostics_period",
+        ).stdout
+        assert "Max value: 60.0" in described
         shipped = next((venv / "lib").glob("python3*/site-packages/evorbc_ros/settings"))
         loaded = ros2("param", "load", "/arbitrator", str(shipped / "ros" / "arbitrator.yaml"))
         assert loaded.returncode == 0 and "failed" not in loaded.stdout + loaded.stderr
         assert "Set parameter robot successful" in loaded.stdout
         assert ros2("lifecycle", "set", "/arbitrator", "deactivate").returncode == 0
-        assert ros2("lifecycle", "get", "/arbitrator").stdout.strip() == "inactive [2]"
+        until(lambda out: out.strip() == "inactive [2]", "lifecycle", "get", "/arbitrator")
         echo = ros2("topic", "echo", "--once", "/diagnostics")
         assert "name: /arbitrator" in echo.stdout and "value: inactive" in echo.stdout
     finally:
