@@ -11,7 +11,7 @@ OUT    ?= demo-output
 # section 10).
 export PYTHONSAFEPATH := 1
 
-.PHONY: demo demo-hexapod demo-a1 demo-repertoire demo-evolve test test-fast lint bench bench-generalise clean
+.PHONY: demo demo-hexapod demo-a1 demo-repertoire demo-evolve test test-fast fuzz lint bench bench-generalise clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -65,6 +65,12 @@ test: lint
 # budgets, the plugin package): a few minutes, for working on the code.
 test-fast: lint
 	$(PY) -m pytest -q -m "not slow"
+
+# The whole fuzz corpus (tests/fuzz): every named hostile file at full size (a 3 M-primitive
+# repertoire, a 16 GiB zip bomb) and 100 mutants of each format, loaded through the command
+# line; the table goes to docs/fuzz.md. The suite runs a fast subset (tests/test_fuzz.py).
+fuzz: $(STAMP)
+	$(PY) tests/fuzz/sweep.py --big --per-kind 100 --record docs/fuzz.md
 
 bench: $(STAMP)
 	$(PY) bench/bench_repertoire.py

@@ -1,0 +1,1 @@
+"""A seeded corpus of broken and hostile input files, and the sweep that loads them."""
