@@ -250,6 +250,26 @@ def table(outcomes: list[Outcome]) -> str:
     return "\n".join(lines) + "\n"
 
 
+RECORD_HEAD = """# The fuzz corpus: what evorbc does with hostile and broken files
+
+Made by `make fuzz` (`tests/fuzz/sweep.py --big --per-kind 100 --record docs/fuzz.md`) on
+{machine}. Every case is a file set and the command line that loads it, run through
+`evorbc-evolve` or `evorbc-study` as a user would (docs/design.md section 12). *Named*
+cases are hostile or careless files that must be refused; *mutants* are valid files
+changed at random from a seed, which may be accepted or refused. A failure is a hang (no
+answer in 60 s), a crash, an internal error, a traceback, several lines, or a refusal that
+names none of the case's files. The suite runs a fast subset (tests/test_fuzz.py).
+
+"""
+
+
+def _machine() -> str:
+    import platform
+
+    day = time.strftime("%Y-%m-%d")
+    return f"{os.cpu_count()} cores, Python {platform.python_version()}, {day}"
+
+
 def main(argv=None) -> int:
     """Run the corpus, print the table, and optionally write it to a Markdown file."""
     p = argparse.ArgumentParser(prog="sweep.py", description=__doc__.splitlines()[0])
@@ -289,7 +309,8 @@ def main(argv=None) -> int:
     )
     print(text + "\n" + summary)
     if args.record:
-        Path(args.record).write_text(text + "\n" + summary + "\n")
+        head = RECORD_HEAD.format(machine=_machine())
+        Path(args.record).write_text(f"{head}{text}\n{summary}\n")
     return 1 if failed else 0
 
 
