@@ -50,7 +50,8 @@ class GraphRun:
                     record_file=str(self.choices), arbitrator=self.arb, repertoire=str(repertoire)
                 )
             if name == "primitive_executor":
-                params["robot"] = robot
+                # As sim_bridge.graph sets it: every command answers a primitive.
+                params.update(robot=robot, lockstep=mode == "lockstep")
             self.start(name, module, params)
         self.bridge = self.start(
             "sim_bridge",

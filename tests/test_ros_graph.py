@@ -64,6 +64,31 @@ def test_lockstep_graph_makes_the_offline_choices_and_reaches_the_target(tmp_pat
     assert got["reached"] == outcomes[k].reached
 
 
+@pytest.mark.slow
+def test_lockstep_parity_holds_under_cpu_load(tmp_path, offline):
+    # Two busy processes on a 2-core machine (load 4 with the graph's five): the executor
+    # handles some primitives before the same cycle's /clock, which made its keep-alive
+    # send a command of its own (tests/test_lockstep_commands.py). 30 s of gaps each run.
+    _, result = offline
+    k, cycles = MAZES.index("gaps"), 300
+    busy = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(2)]
+    try:
+        for run_index in range(3):
+            folder = tmp_path / str(run_index)
+            folder.mkdir()
+            run = GraphRun(folder, 230 + run_index, "gaps", episode_time=cycles / 10)
+            run.finish(timeout=180)
+            choices = run.recorded_choices()
+            assert len(choices) >= cycles, f"run {run_index}: {len(choices)} choices"
+            np.testing.assert_array_equal(
+                choices[:cycles], result.choice[k, :cycles], err_msg=f"run {run_index}"
+            )
+    finally:
+        for p in busy:
+            p.kill()
+            p.wait()
+
+
 def test_realtime_mode_runs_at_ten_hertz(tmp_path):
     run = GraphRun(tmp_path, 160, "zigzag", mode="realtime", episode_time=3.0)
     start = time.monotonic()

@@ -44,7 +44,7 @@ def test_the_default_graph_runs_the_shipped_4ws_5_controller_in_obstacle():
         "laser_sensor": {"use_sim_time": True, "sensor_layout": arb},
         "radar_sensor": {"use_sim_time": True, "sensor_layout": arb},
         "arbitrator": {"use_sim_time": True, "arbitrator": arb, "robot": "4ws-5"},
-        "primitive_executor": {"use_sim_time": True, "robot": "4ws-5"},
+        "primitive_executor": {"use_sim_time": True, "robot": "4ws-5", "lockstep": True},
         "sim_bridge": {
             "robot": "4ws-5",
             "maze": "obstacle",

@@ -219,6 +219,12 @@ PARAMETERS: dict[str, tuple[ParamSpec, ...]] = {
             "differential drive: geometry_msgs/TwistStamped on cmd_vel (Jazzy's "
             "diff_drive_controller); false: Twist (TurtleBot3's base, older stacks)",
         ),
+        spec(
+            "lockstep",
+            False,
+            "a lockstep simulation: send a command only in answer to a primitive, never "
+            "on the timer (the simulation takes each command for a cycle's)",
+        ),
         *COMMON,
     ),
 }

@@ -242,7 +242,7 @@ def sim_graph(
                 robot=robot,
                 record_file=record_file,
             ),
-            evorbc("primitive_executor", managed=True, robot=robot),
+            evorbc("primitive_executor", managed=True, robot=robot, lockstep=mode == "lockstep"),
             NodeSpec(
                 "sim_bridge",
                 "sim_bridge",

@@ -21,7 +21,8 @@ is the robot's command interface, named by its registration
   geometry_msgs/TwistStamped (Twist with ``twist_stamped: false``).
 
 A command goes out at once for every new primitive, and again whenever 1.5 periods
-(0.15 s) pass without one, so the controllers keep receiving 10 Hz commands. If
+(0.15 s) pass without one, so the controllers keep receiving 10 Hz commands (not under a
+lockstep simulation, ``lockstep: true``, where every command answers one primitive). If
 the primitive or a sensor input is older than ``stale_timeout`` (0.3 s) the executor
 stops the robot within one cycle (4WS: zero wheel speed, steering held; hexapod: every
 joint held at its last target), and resumes when they return.
@@ -75,6 +76,12 @@ class PrimitiveExecutorNode(ManagedNode):
         self.apply_live("wheel_radius", p["wheel_radius"])
         self.period, self.stale_timeout = p["period"], p["stale_timeout"]
         self.zero_before_primitive = p["zero_before_first_primitive"]
+        # Under a lockstep simulation the bridge steps the world once per set of commands:
+        # a command of the executor's own would be taken for the next cycle's. Under load
+        # the executor can handle a primitive before the same cycle's /clock, so by its
+        # clock the primitive came a cycle early and the keep-alive fired a cycle later
+        # (docs/design.md section 9, "Lockstep under load").
+        self.lockstep = p["lockstep"]
         inputs = [f"evorbc/{name}" for name in p["watched_inputs"]]
         try:
             interface = self.spec.load("commands")
@@ -146,7 +153,7 @@ class PrimitiveExecutorNode(ManagedNode):
         now = now_seconds(self)
         self.inputs[topic].tick(now)
         self.logic.on_input(topic, now)
-        if self.stopped_reason and self.active:
+        if self.stopped_reason and self.active and not self.lockstep:
             command = self.logic.command(now)
             if not command.stopped:
                 self.publish(command, now)
@@ -155,6 +162,8 @@ class PrimitiveExecutorNode(ManagedNode):
         """Stop on stale inputs; otherwise keep commands flowing at least every period."""
         if not self.active or not (self.primitive_seen or self.zero_before_primitive):
             return  # never commanded: leave the controllers to whoever drives them (teleop)
+        if self.lockstep:
+            return  # every command answers a primitive (configure says why)
         now = now_seconds(self)
         command = self.logic.command(now)
         # A stop for stale inputs is repeated every tick. The arbitrator's own "no
