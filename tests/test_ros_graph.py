@@ -64,25 +64,27 @@ def test_lockstep_graph_makes_the_offline_choices_and_reaches_the_target(tmp_pat
     assert got["reached"] == outcomes[k].reached
 
 
+#: ROS domains of the parity runs under load (no other test uses 140-142).
+LOADED_DOMAINS = (140, 141, 142)
+
+
 @pytest.mark.slow
-def test_lockstep_parity_holds_under_cpu_load(tmp_path, offline):
-    # Two busy processes on a 2-core machine (load 4 with the graph's five): the executor
-    # handles some primitives before the same cycle's /clock, which made its keep-alive
-    # send a command of its own (tests/test_lockstep_commands.py). 30 s of gaps each run.
+def test_lockstep_parity_holds_next_to_busy_processes(tmp_path, offline):
+    # Three 30 s runs of gaps (300 cycles each) with two busy processes on the machine's
+    # cores: lockstep waits for every answer, so load may slow it, never change it.
     _, result = offline
     k, cycles = MAZES.index("gaps"), 300
     busy = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(2)]
     try:
-        for run_index in range(3):
-            folder = tmp_path / str(run_index)
+        for i, domain in enumerate(LOADED_DOMAINS):
+            folder = tmp_path / str(i)
             folder.mkdir()
-            run = GraphRun(folder, 230 + run_index, "gaps", episode_time=cycles / 10)
-            run.finish(timeout=180)
+            run = GraphRun(folder, domain, "gaps", episode_time=cycles / 10)
+            got = run.finish(timeout=180)
             choices = run.recorded_choices()
-            assert len(choices) >= cycles, f"run {run_index}: {len(choices)} choices"
-            np.testing.assert_array_equal(
-                choices[:cycles], result.choice[k, :cycles], err_msg=f"run {run_index}"
-            )
+            assert len(choices) in (cycles, cycles + 1), f"run {i}: {len(choices)} choices"
+            np.testing.assert_array_equal(choices[:cycles], result.choice[k, :cycles])
+            np.testing.assert_array_equal(got["trajectory"], result.pose[k, : cycles + 1])
     finally:
         for p in busy:
             p.kill()

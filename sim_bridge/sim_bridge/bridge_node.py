@@ -21,6 +21,13 @@ Modes:
   ``lockstep_timeout`` s without commands.
 * ``realtime``: step every 0.1 s of wall time with the latest commands.
 
+One graph per ROS domain and namespace: a second publisher on a topic of the graph (this
+bridge's outputs, the sensor readings, the primitive, the commands) is another graph's
+node, whose answers this bridge would take for its own. In lockstep the run then stops
+with one line naming the topic (status 1, no result written) rather than finish an episode
+that silently left the offline one; in realtime it is a warning (docs/design.md section 9,
+"One graph per domain").
+
 The episode ends at the target, when the hexapod falls over, or after ``episode_time``;
 the result (reached, fell, time, eq. 5 fitness, trajectory) is logged and, if
 ``result_file`` is set, written as JSON.
@@ -30,6 +37,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 import time
 
@@ -62,6 +70,20 @@ from evorbc_ros.nodes.diagnostics import DiagnosticsPublisher
 from evorbc_ros.nodes.parameters import ParameterGuard, declare_all
 from evorbc_ros.robots import registry
 from sim_bridge.bridge_parameters import PARAMETERS, REMOVED
+
+#: Topics of the graph besides the commands: each has exactly one publisher in one run.
+GRAPH_TOPICS = (
+    "/clock",
+    "scan",
+    "odom",
+    "joint_states",
+    "evorbc/rangefinders",
+    "evorbc/goal_sectors",
+)
+
+
+class SharedGraphError(Exception):
+    """Another graph publishes on this run's topics (the message names one)."""
 
 
 def stamp(seconds: float) -> Time:
@@ -241,6 +263,36 @@ class SimBridgeNode(Node):
         out = [t for t in self.wait_subscribers if self.count_subscribers(t) == 0]
         return out + [t for t in self.wait_publishers if self.count_publishers(t) == 0]
 
+    def other_graph(self) -> str:
+        """Which topic has a second publisher (another graph in this domain); "" if none.
+
+        Two graphs in one ROS domain and namespace answer each other's states: each run
+        then diverges from its offline episode, and its arbitrator records extra choices
+        (docs/design.md section 9). A node killed without a clean exit also leaves its
+        publisher behind until its DDS lease ends (about 20 s), so a node restarted within
+        that time counts as a second one.
+        """
+        for topic in (*GRAPH_TOPICS, *self.wait_publishers):
+            count = self.count_publishers(topic)
+            if count > 1:
+                domain = os.environ.get("ROS_DOMAIN_ID", "0")
+                return (
+                    f"{self.resolve_topic_name(topic)} has {count} publishers: another graph "
+                    f"runs in ROS domain {domain} with the same namespace; give each graph "
+                    "its own ROS_DOMAIN_ID or namespace"
+                )
+        return ""
+
+    def check_alone(self) -> None:
+        """Lockstep: stop before stepping with commands that may be another graph's.
+
+        Raises:
+            SharedGraphError: naming the topic.
+        """
+        problem = self.other_graph()
+        if problem:
+            raise SharedGraphError(problem)
+
     def spin_for(self, executor, seconds: float) -> None:
         """Process messages for ``seconds`` of wall time."""
         until = time.monotonic() + seconds
@@ -308,15 +360,17 @@ class SimBridgeNode(Node):
 
     def run_lockstep(self) -> None:
         """The lockstep loop: state out, both commands in, step."""
-        executor = Executor()
+        executor = Executor(context=self.context)
         executor.add_node(self)
         try:
             self.wait_for_graph(executor)
+            self.check_alone()
             self.loop_start = time.monotonic()
             while not self.world.status().done and running():
                 self.fresh = dict.fromkeys(self.fresh, False)
                 self.publish_state()
                 self.wait_for_commands(executor)
+                self.check_alone()  # before the commands move the robot
                 self.advance()
             if running():
                 self.publish_state()  # final state for listeners
@@ -325,11 +379,14 @@ class SimBridgeNode(Node):
 
     def run_realtime(self) -> None:
         """Step every 0.1 s of wall time with whatever commands are current."""
-        executor = Executor()
+        executor = Executor(context=self.context)
         executor.add_node(self)
         period = self.world.dt
         try:
             self.wait_for_graph(executor)
+            shared = self.other_graph()
+            if shared:  # real time is not reproducible anyway: say so and go on
+                self.get_logger().warning(shared)
             self.loop_start = time.monotonic()
             self.publish_state()
             next_tick = time.monotonic() + period
@@ -388,7 +445,11 @@ def episode_verdict(result: dict) -> str:
 
 
 def main(argv=None) -> int:
-    """Run one episode and exit: 0 when it ran (or was interrupted), 2 if it cannot start."""
+    """Run one episode and exit with its status.
+
+    0 when it ran (or was interrupted), 2 if it cannot start, 1 when another graph shares
+    its topics in lockstep (no result is written).
+    """
     status = init_ros(argv)
     if status is not None:
         return status
@@ -404,6 +465,9 @@ def main(argv=None) -> int:
         if not e.logged:
             print(f"error: {e}", file=sys.stderr)
         return 2
+    except SharedGraphError as e:
+        node.get_logger().error(f"lockstep stopped: {e}")
+        return 1
     except Exception as e:
         if not isinstance(e, rclpy.executors.ExternalShutdownException) and not stop_requested():
             raise
