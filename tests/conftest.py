@@ -4,6 +4,7 @@ import os
 import signal
 
 import pytest
+import ros_domains
 
 import evorbc_ros
 
@@ -21,6 +22,13 @@ from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
 
 pytest_plugins = ["ros_helpers"]  # the `ros` fixture for in-process ROS 2 tests
+
+
+@pytest.fixture(autouse=True)
+def _ros_domains():
+    """Give back the ROS domains a test claimed (tests/ros_domains.py) once it ends."""
+    yield
+    ros_domains.release_all()
 
 
 def small_settings(**overrides):

@@ -6,12 +6,16 @@ import signal
 import subprocess
 
 import numpy as np
+from ros_domains import claim_domain
 
 from evorbc_ros.defaults import default_arbitrator
 from sim_bridge.bringup import NODES, node_command
 
 
 def graph_env(domain: int) -> dict:
+    """The environment of a graph's processes: localhost discovery, in ``domain`` if no
+    other suite on the machine uses it, else in a spare domain (:mod:`ros_domains`)."""
+    domain = claim_domain(domain)
     env = dict(
         os.environ,
         ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",

@@ -1,0 +1,30 @@
+"""Two suites on one machine never run graphs in the same ROS domain (tests/ros_domains.py).
+
+Two graphs in one domain answer each other's states, and a lockstep run then leaves its
+offline episode (docs/design.md section 9, "One graph per domain").
+"""
+
+import subprocess
+import sys
+
+from ros_domains import SPARES, claim_domain
+
+
+def test_a_claimed_domain_is_not_given_to_another_process():
+    held = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import sys, time; sys.path.insert(0, 'tests'); from ros_domains import "
+            "claim_domain; print(claim_domain(224), flush=True); time.sleep(60)",
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert held.stdout.readline().strip() == "224"
+        mine = claim_domain(224)
+        assert mine != 224 and mine in SPARES
+    finally:
+        held.kill()
+        held.wait()
