@@ -112,7 +112,14 @@ class ArbitratorFile:
                 f"{source}: not an arbitrator file (format is "
                 f"{data.get('format')!r}, expected {FORMAT!r})"
             )
-        if data.get("version") != VERSION:
+        version = data.get("version")
+        # An int, not 1.0 or true (which compare equal to 1): no writer makes those.
+        if type(version) is not int:
+            raise ArbitratorError(
+                f"{source}: version must be a whole number (the format version, "
+                f"{VERSION}), got {reprlib.repr(version)}"
+            )
+        if version != VERSION:
             raise ArbitratorError(
                 f"{source}: arbitrator format version "
                 f"{data.get('version')!r} is not supported (this evorbc "

@@ -168,8 +168,8 @@ def contents_problem(r) -> str | None:
     if r.quality.min() < q_low or r.quality.max() > q_high:
         bad = int(np.argmax((r.quality < q_low) | (r.quality > q_high)))
         return (
-            f"primitives.quality[{bad}] is {float(r.quality[bad])!r}, outside [{q_low:g}, {q_high:g}], "
-            f"the range of metric {r.metric}"
+            f"primitives.quality[{bad}] is {float(r.quality[bad])!r}, outside "
+            f"[{q_low:g}, {q_high:g}], the range of metric {r.metric}"
         )
     if np.abs(r.heading).max() > HEADING_LIMIT:
         bad = int(np.argmax(np.abs(r.heading) > HEADING_LIMIT))
