@@ -391,7 +391,7 @@ def _needed_nodes(inputs: set[int], outputs: list[int], edges: list[tuple[int, i
     return needed
 
 
-def _topological_order(needed: set[int], edges: list[tuple[int, int]]) -> list[int]:
+def topological_order(needed: set[int], edges: list[tuple[int, int]]) -> list[int]:
     """The needed nodes in waves of Kahn's algorithm, each wave sorted by key.
 
     Iterative and linear in edges (plus the sorting of each wave), so a chain of any
@@ -471,7 +471,7 @@ def _compile(spec: NetworkSpec) -> CompiledNetwork:
         idle = sorted(n for n in needed if n not in targets)
         return _arrays(spec, nodes, inputs, outputs, order, idle, enabled, needed)
 
-    order = _topological_order(needed, edges)
+    order = topological_order(needed, edges)
     return _arrays(spec, nodes, inputs, outputs, order, [], enabled, needed)
 
 

@@ -55,6 +55,7 @@ from offline_evolution.arbitrator.selection import (
     validation_rows,
 )
 from offline_evolution.arbitrator.warm_start import network_fingerprint, seed_population
+from offline_evolution.checkpoint import VERSION as CHECKPOINT_VERSION
 from offline_evolution.checkpoint import (
     CheckpointError,
     Interrupted,
@@ -513,6 +514,7 @@ class Evolution:
         """Write a JSON checkpoint between generations (atomically)."""
         data = {
             "kind": CHECKPOINT_KIND,
+            "version": CHECKPOINT_VERSION,
             "settings": self.settings.as_dict(),
             "population": population_to_dict(self.population),
             "best": self.best,
@@ -597,6 +599,9 @@ class Evolution:
                 require(g, "fitness", float, f"hall_of_fame.{part}[{i}].")
                 if part == "nominal":
                     require(g, "nominal_fitness", float, f"hall_of_fame.{part}[{i}].")
+        size = require(hall, "size", int, "hall_of_fame.")
+        if size < 1:
+            raise ValueError(f"hall_of_fame.size must be 1 or more, got {size}")
         self.hall = HallOfFame.from_dict(hall)
         history = require(data, "history", list)
         if len(history) != generation:
@@ -615,7 +620,10 @@ class Evolution:
             self.final_scores = PostScores.from_dict(
                 require(data, "post_final_scores", dict), where
             )
-        return float(require(data, "elapsed", float))
+        elapsed = float(require(data, "elapsed", float))
+        if elapsed < 0:
+            raise ValueError(f"elapsed must be 0 s or more, got {elapsed}")
+        return elapsed
 
 
 def evolve(
