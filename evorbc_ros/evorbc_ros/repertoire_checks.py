@@ -190,6 +190,8 @@ def contents_problem(r) -> str | None:
     cells = _cells(r.behaviour, r.archive, lo, hi)
     if cells is None:
         return None
+    keep = cells >= 0  # -1: a behaviour as near to two CVT centroids (which pyribs chose)
+    cells = np.where(keep, cells, -1 - np.arange(len(cells)))
     order = np.argsort(cells, kind="stable")
     same = np.flatnonzero(cells[order][1:] == cells[order][:-1])
     if same.size:
@@ -219,5 +221,11 @@ def _cells(behaviour: np.ndarray, archive: dict, lo: np.ndarray, hi: np.ndarray)
     for start in range(0, len(behaviour), step):
         b = behaviour[start : start + step]
         d = ((b[:, None, :] - c[None, :, :]) ** 2).sum(axis=2)
-        out[start : start + step] = d.argmin(axis=1)
+        nearest = d.argmin(axis=1)
+        if len(c) > 1:
+            # The centroids are mirrored (y -> -y), so a behaviour on the x axis is as near
+            # to two of them; pyribs' k-d tree may take either, so such a one is left out.
+            two = np.partition(d, 1, axis=1)[:, :2]
+            nearest[two[:, 1] - two[:, 0] <= 1e-12 * (1.0 + two[:, 1])] = -1
+        out[start : start + step] = nearest
     return out
