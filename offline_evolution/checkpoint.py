@@ -22,6 +22,7 @@ from evorbc_ros.atomic_io import atomic_write
 from evorbc_ros.input_files import DATA_LIMIT, is_regular, read_regular
 from evorbc_ros.json_files import first_difference, parse_json
 from evorbc_ros.limits import CHECKPOINT_ARRAY_BYTES
+from evorbc_ros.repertoire_checks import version_problem
 
 _HEADER = "__header__"
 #: The checkpoint format version written from 2026-11-28 on; a checkpoint without one is
@@ -210,29 +211,22 @@ def load_json_checkpoint(path: str | os.PathLike) -> dict:
         raise CheckpointError(f"{path}: not a checkpoint (not JSON)", discardable=False) from None
     if not isinstance(data, dict):
         raise CheckpointError(f"{path}: not a checkpoint (not a JSON object)", discardable=False)
-    check_version(data, str(path))
     return data
 
 
 def check_version(header: dict, source: str) -> None:
     """Refuse a checkpoint whose ``version`` is not this format's (an int; absent is 1).
 
+    Called once the file is known to be a checkpoint (``--restart`` may then discard it).
+
     Raises:
         CheckpointError: naming the file and the version found.
     """
     if "version" not in header:
         return
-    version = header["version"]
-    if type(version) is not int:  # 1.0 and true equal 1, but no writer makes them
-        raise CheckpointError(
-            f"{source}: version must be a whole number (the format version, {VERSION}), "
-            f"got {version!r:.40}"
-        )
-    if version != VERSION:
-        raise CheckpointError(
-            f"{source}: checkpoint format version {version} is not supported (this evorbc "
-            f"reads version {VERSION})"
-        )
+    problem = version_problem(header["version"], "checkpoint", VERSION)
+    if problem:
+        raise CheckpointError(f"{source}: {problem}")
 
 
 def checkpoint_kind(path: str | os.PathLike) -> str | None:

@@ -25,11 +25,12 @@ from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.network import NetworkSpec
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.repertoire_checks import HEADING_LIMIT, QUALITY_RANGES
+from offline_evolution.arbitrator.evolve import CHECKPOINT_KIND as NEAT_KIND
 from offline_evolution.arbitrator.evolve import evolve
 from offline_evolution.checkpoint import (
     CheckpointError,
+    checkpoint_kind,
     load_checkpoint,
-    load_json_checkpoint,
     save_checkpoint,
 )
 from offline_evolution.quality import METRICS
@@ -103,7 +104,7 @@ def test_a_repertoire_no_run_writes_is_refused_naming_the_key(
     tmp_path, capsys, small_repertoire, case
 ):
     change, needle = REPERTOIRE_CASES[case]
-    tree = small_repertoire.to_dict()
+    tree = copy.deepcopy(small_repertoire.to_dict())  # to_dict shares the archive dict
     tree["metric"] = "circular"
     change(tree)
     path, out = tmp_path / "r.json", tmp_path / "r.csv"
@@ -388,14 +389,16 @@ def test_a_neat_population_that_does_not_add_up_is_refused(neat_checkpoint, smal
 
 
 @pytest.mark.parametrize("version", [1.0, True])
-def test_a_neat_checkpoint_version_must_be_an_int(neat_checkpoint, version):
-    _, ckpt = neat_checkpoint
+def test_a_neat_checkpoint_version_must_be_an_int(neat_checkpoint, small_repertoire, version):
+    s, ckpt = neat_checkpoint
     data = json.loads(ckpt.read_text())
     assert data["version"] == 1
     data["version"] = version
     ckpt.write_text(json.dumps(data))
-    with pytest.raises(CheckpointError, match="version must be a whole number"):
-        load_json_checkpoint(ckpt)
+    with pytest.raises(CheckpointError, match="version must be a whole number") as info:
+        evolve(s, small_repertoire, checkpoint=ckpt)
+    assert info.value.discardable  # recognisably a NEAT checkpoint: --restart may delete it
+    assert checkpoint_kind(ckpt) == NEAT_KIND
 
 
 def test_a_checkpoint_without_a_version_still_loads(map_elites_checkpoint):

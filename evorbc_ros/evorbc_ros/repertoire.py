@@ -43,6 +43,7 @@ from evorbc_ros.repertoire_checks import (
     archive_problem,
     contents_problem,
     number_column,
+    version_problem,
 )
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.primitive import GENE_HIGH, GENE_LOW, ParameterSpec
@@ -193,18 +194,9 @@ class Repertoire:
             raise RepertoireError(
                 f"{source}: not a repertoire file (format is {fmt!r}, expected {FORMAT!r})"
             )
-        version = data.get("version")
-        # An int, not 1.0 or true (which compare equal to 1): no writer makes those.
-        if type(version) is not int:
-            raise RepertoireError(
-                f"{source}: version must be a whole number (the format version, "
-                f"{VERSION}), got {reprlib.repr(version)}"
-            )
-        if version != VERSION:
-            raise RepertoireError(
-                f"{source}: repertoire format version {version!r} is not "
-                f"supported (this evorbc reads version {VERSION})"
-            )
+        problem = version_problem(data.get("version"), "repertoire", VERSION)
+        if problem:
+            raise RepertoireError(f"{source}: {problem}")
         try:
             prims = _require(data, "primitives", dict, source)
             params = _require(data, "parameters", list, source)

@@ -49,6 +49,25 @@ EVAL_TIME_RANGE = (0.0, 3600.0)
 _GRID_EPSILON = 1e-6
 
 
+def version_problem(version: Any, kind: str, expected: int) -> str | None:
+    """Why ``version`` is not the format version ``expected`` of ``kind`` files, or None.
+
+    It must be a JSON integer: ``1.0`` and ``true`` compare equal to 1 in Python, but no
+    writer makes them, so a file holding them was made or edited by something else.
+    """
+    if type(version) is not int:
+        return (
+            f"version must be a whole number (the format version, {expected}), "
+            f"got {reprlib.repr(version)}"
+        )
+    if version != expected:
+        return (
+            f"{kind} format version {version} is not supported (this evorbc reads "
+            f"version {expected})"
+        )
+    return None
+
+
 class ColumnError(ValueError):
     """A column of primitives holds something other than numbers (message: the problem)."""
 

@@ -60,6 +60,7 @@ from offline_evolution.checkpoint import (
     CheckpointError,
     Interrupted,
     check_same_robot,
+    check_version,
     load_json_checkpoint,
     settings_mismatch,
 )
@@ -542,6 +543,7 @@ class Evolution:
         data = load_json_checkpoint(path)
         if data.get("kind") != CHECKPOINT_KIND:
             raise CheckpointError(f"{path}: not a NEAT evolution checkpoint", discardable=False)
+        check_version(data, str(path))
         if not isinstance(data.get("settings"), dict):
             raise CheckpointError(f"{path}: not a usable checkpoint (settings missing)")
         # Selection settings never change the population, and a file's location never
