@@ -13,6 +13,7 @@ import itertools
 import json
 import math
 import os
+import re
 import zipfile
 from pathlib import Path
 
@@ -412,3 +413,27 @@ def test_a_checkpoint_without_a_version_still_loads(map_elites_checkpoint):
     assert "version" not in load_checkpoint(map_elites_checkpoint)[0]
     assert checkpoint.VERSION == 1
     save_checkpoint(map_elites_checkpoint, header, arrays)
+
+
+# -- the ask/tell loop refuses at tell what the file would refuse at the end ----------------
+
+
+@pytest.mark.parametrize(
+    ("quality", "heading", "needle"),
+    [
+        (5.0, 0.0, "quality must lie in [0, 1] for metric circular"),
+        (-0.5, 0.0, "quality must lie in [0, 1] for metric circular"),
+        (0.5, 1e6, "heading must be finite and within +-1000 rad"),
+    ],
+)
+def test_tell_refuses_values_no_repertoire_file_may_hold(quality, heading, needle):
+    from evorbc_ros.robots.primitive import ParameterSpec
+    from offline_evolution.repertoire.map_elites import MapElites
+
+    settings = small_settings()
+    two = (ParameterSpec("a", "m/s", -1.0, 1.0), ParameterSpec("b", "rad/s", -2.0, 2.0))
+    run = MapElites(settings, parameters=two, max_reach=0.5)
+    genes = run.ask()
+    n = len(genes)
+    with pytest.raises(ValueError, match=re.escape(needle)):
+        run.tell(genes, np.full(n, quality), 0.1 * genes, np.full(n, heading))
