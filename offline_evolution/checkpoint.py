@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 import os
 import zipfile
 from pathlib import Path
@@ -20,8 +21,13 @@ import numpy as np
 from evorbc_ros.atomic_io import atomic_write
 from evorbc_ros.input_files import DATA_LIMIT, is_regular, read_regular
 from evorbc_ros.json_files import first_difference, parse_json
+from evorbc_ros.limits import CHECKPOINT_ARRAY_BYTES
+from evorbc_ros.repertoire_checks import version_problem
 
 _HEADER = "__header__"
+#: The checkpoint format version written from 2026-11-28 on; a checkpoint without one is
+#: of the same layout (written before the key existed).
+VERSION = 1
 
 
 class CheckpointError(ValueError):
@@ -51,6 +57,7 @@ class Interrupted(Exception):
 def save_checkpoint(path: str | os.PathLike, header: dict, arrays: dict[str, np.ndarray]):
     """Write ``header`` (JSON-safe) and ``arrays`` to ``path`` atomically."""
     buf = io.BytesIO()
+    header = {"version": VERSION, **header}
     np.savez(buf, **{_HEADER: np.array(json.dumps(header))}, **arrays)
     atomic_write(path, lambda f: f.write(buf.getvalue()), binary=True)
 
@@ -115,11 +122,61 @@ def _open(path: str | os.PathLike):
             f"{source}: not a checkpoint (not an .npz archive)", discardable=False
         )
     try:
+        check_npz_sizes(data, source)
         return np.load(data, allow_pickle=False)
+    except CheckpointError:
+        raise
     except _READ_ERRORS as e:
         raise CheckpointError(
             f"{source}: not a checkpoint ({_reason(e)})", discardable=False
         ) from None
+
+
+def check_npz_sizes(data: io.BytesIO, source: str) -> None:
+    """Refuse an ``.npz`` whose arrays would inflate to too much, before inflating any.
+
+    Each member's ``.npy`` header (a few hundred bytes at its start) gives the array's
+    shape and dtype; shape x itemsize must be what the member's declared size leaves after
+    the header (zipfile never inflates past the declared size), and the arrays together
+    must stay within :data:`~evorbc_ros.limits.CHECKPOINT_ARRAY_BYTES`. A zip bomb of a
+    few MB that would inflate to 16 GiB is refused here rather than ending in MemoryError.
+
+    Raises:
+        CheckpointError: naming the member and what is wrong (not ``discardable`` if the
+            file is no ``.npz`` of arrays at all).
+    """
+    total = 0
+    with zipfile.ZipFile(data) as archive:
+        for info in archive.infolist():
+            name = info.filename
+            with archive.open(info) as member:
+                try:
+                    version = np.lib.format.read_magic(member)
+                    read = (
+                        np.lib.format.read_array_header_1_0
+                        if version == (1, 0)
+                        else np.lib.format.read_array_header_2_0
+                    )
+                    shape, _, dtype = read(member)
+                    header_size = member.tell()
+                except ValueError as e:
+                    raise CheckpointError(
+                        f"{source}: not a checkpoint ({name} is not a numpy array: {e})",
+                        discardable=False,
+                    ) from None
+            size = math.prod(shape) * dtype.itemsize
+            if dtype.hasobject:  # a pickle: never loaded (allow_pickle=False names it)
+                size = info.file_size
+            elif size != info.file_size - header_size:
+                raise CheckpointError(
+                    f"{source}: not a usable checkpoint ({name} declares shape {shape} of "
+                    f"{dtype}, {size:,} bytes, but holds {info.file_size - header_size:,})"
+                )
+            total += size
+            problem = CHECKPOINT_ARRAY_BYTES.problem(total, "once inflated")
+            if problem:
+                raise CheckpointError(f"{source}: not a usable checkpoint ({problem})")
+    data.seek(0)
 
 
 def load_checkpoint(path: str | os.PathLike) -> tuple[dict, dict[str, np.ndarray]]:
@@ -133,6 +190,7 @@ def load_checkpoint(path: str | os.PathLike) -> tuple[dict, dict[str, np.ndarray
     """
     with _open(path) as data:
         header = _header(data, str(path))
+        check_version(header, str(path))
         try:
             arrays = {k: data[k] for k in data.files if k != _HEADER}
         except _READ_ERRORS as e:
@@ -154,6 +212,21 @@ def load_json_checkpoint(path: str | os.PathLike) -> dict:
     if not isinstance(data, dict):
         raise CheckpointError(f"{path}: not a checkpoint (not a JSON object)", discardable=False)
     return data
+
+
+def check_version(header: dict, source: str) -> None:
+    """Refuse a checkpoint whose ``version`` is not this format's (an int; absent is 1).
+
+    Called once the file is known to be a checkpoint (``--restart`` may then discard it).
+
+    Raises:
+        CheckpointError: naming the file and the version found.
+    """
+    if "version" not in header:
+        return
+    problem = version_problem(header["version"], "checkpoint", VERSION)
+    if problem:
+        raise CheckpointError(f"{source}: {problem}")
 
 
 def checkpoint_kind(path: str | os.PathLike) -> str | None:

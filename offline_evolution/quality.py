@@ -10,9 +10,11 @@ primitive that must be discarded.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 
+from evorbc_ros.repertoire_checks import QUALITY_RANGES
 from sim_bridge.robots.base import PrimitiveOutcome
 
 #: Tilt above which a legged primitive is discarded (paper eq. 6, T = 45 deg).
@@ -74,14 +76,29 @@ def _sum(*metrics: Callable[[PrimitiveOutcome], np.ndarray]):
     return combined
 
 
-#: Metric name -> (function, highest possible quality).
-METRICS: dict[str, tuple[Callable[[PrimitiveOutcome], np.ndarray], float]] = {
-    "circular": (circular_quality, 1.0),
-    "radial": (radial_quality, 1.0),
-    "distance": (distance_quality, 1.0),
-    "distance+circular": (_sum(distance_quality, circular_quality), 2.0),
-    "distance+radial": (_sum(distance_quality, radial_quality), 2.0),
-    "circular+tilt": (circular_tilt_quality, 2.0),
+class Metric(NamedTuple):
+    """A quality metric and the range of qualities it gives (``low <= q <= high``)."""
+
+    function: Callable[[PrimitiveOutcome], np.ndarray]
+    high: float
+    low: float
+
+
+def _metric(name: str, function: Callable[[PrimitiveOutcome], np.ndarray]) -> Metric:
+    # The range lives with the onboard package, which checks repertoire files against it
+    # and must not import this module (docs/design.md section 12).
+    low, high = QUALITY_RANGES[name]
+    return Metric(function, high, low)
+
+
+#: Metric name -> (function, highest possible quality, lowest possible quality).
+METRICS: dict[str, Metric] = {
+    "circular": _metric("circular", circular_quality),
+    "radial": _metric("radial", radial_quality),
+    "distance": _metric("distance", distance_quality),
+    "distance+circular": _metric("distance+circular", _sum(distance_quality, circular_quality)),
+    "distance+radial": _metric("distance+radial", _sum(distance_quality, radial_quality)),
+    "circular+tilt": _metric("circular+tilt", circular_tilt_quality),
 }
 
 

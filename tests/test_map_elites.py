@@ -262,6 +262,10 @@ def test_symmetry_counts_filled_cells_whose_mirror_cell_is_filled(small_repertoi
         behaviour=behaviour,
         heading=np.zeros(5),
         quality=np.array([1.0, 1.5, 1.5, 1.2, 1.0]),
+        # Qualities up to 2 and two primitives in one 4 cm cell: no archive (whose cells
+        # hold one each) and a metric whose range is [0, 2].
+        metric="distance+circular",
+        archive={},
     )
     s = repertoire_stats(rep, bin_size=0.04)
     # cells (0, 0), (2, 5), (2, -5), (8, 3): 3 off the x axis, 2 of them mirrored

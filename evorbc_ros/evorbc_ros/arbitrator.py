@@ -40,6 +40,7 @@ from evorbc_ros.json_files import load_json_file
 from evorbc_ros.mapping import MAPPINGS, MappingFunction, PrimitiveLookup, choose_primitive
 from evorbc_ros.network import NetworkError, NetworkSpec
 from evorbc_ros.repertoire import Repertoire, robot_problem
+from evorbc_ros.repertoire_checks import version_problem
 from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.robots.registry import lookup
 from evorbc_ros.sensors import SensorLayout
@@ -112,12 +113,9 @@ class ArbitratorFile:
                 f"{source}: not an arbitrator file (format is "
                 f"{data.get('format')!r}, expected {FORMAT!r})"
             )
-        if data.get("version") != VERSION:
-            raise ArbitratorError(
-                f"{source}: arbitrator format version "
-                f"{data.get('version')!r} is not supported (this evorbc "
-                f"reads version {VERSION})"
-            )
+        problem = version_problem(data.get("version"), "arbitrator", VERSION)
+        if problem:
+            raise ArbitratorError(f"{source}: {problem}")
         kind = data.get("kind")
         if kind not in KINDS:
             raise ArbitratorError(f"{source}: kind must be one of {', '.join(KINDS)}, got {kind!r}")

@@ -83,6 +83,8 @@ def _suggest(count: int) -> int:
 # mazes hold tens of walls and generated ones a few hundred.
 #: Primitives in one repertoire file.
 PRIMITIVES = Limit("primitives", "EVORBC_MAX_PRIMITIVES", 1_000_000)
+#: Cells of one repertoire's archive (the grid's dims multiplied, or a CVT's cells).
+ARCHIVE_CELLS = Limit("cells", "EVORBC_MAX_ARCHIVE_CELLS", 10_000_000)
 #: Nodes (hidden and output) in one network.
 NETWORK_NODES = Limit("nodes", "EVORBC_MAX_NETWORK_NODES", 10_000)
 #: Connections in one network.

@@ -31,6 +31,8 @@ from typing import ClassVar
 
 import numpy as np
 
+from evorbc_ros.limits import NETWORK_CONNECTIONS, NETWORK_NODES
+
 
 def _clamp(z: float, lo: float, hi: float) -> float:
     return max(lo, min(hi, z))
@@ -168,7 +170,21 @@ class NetworkSpec:
 
     @classmethod
     def from_dict(cls, data: dict) -> NetworkSpec:
-        """Build from :meth:`to_dict`'s form; raises :class:`NetworkError` if malformed."""
+        """Build from :meth:`to_dict`'s form; raises :class:`NetworkError` if malformed.
+
+        The numbers of nodes and connections are checked against
+        :data:`~evorbc_ros.limits.NETWORK_NODES` and ``NETWORK_CONNECTIONS`` before anything
+        is built, so a file cannot ask for unbounded work (docs/design.md section 12).
+        """
+        if not isinstance(data, dict):
+            raise NetworkError(f"the network must be an object, got {type(data).__name__}")
+        for key in ("inputs", "outputs", "nodes", "connections"):
+            if key in data and not isinstance(data[key], list):
+                raise NetworkError(f"{key} must be a list, got {type(data[key]).__name__}")
+        for limit, key in ((NETWORK_NODES, "nodes"), (NETWORK_CONNECTIONS, "connections")):
+            problem = limit.problem(len(data.get(key, ())), f"in network.{key}")
+            if problem:
+                raise NetworkError(problem)
         try:
             spec = cls(
                 input_keys=tuple(_int(k, "inputs") for k in data["inputs"]),
@@ -358,14 +374,56 @@ def _flag(value, what: str) -> bool:
 
 
 def _needed_nodes(inputs: set[int], outputs: list[int], edges: list[tuple[int, int]]) -> set:
-    """Nodes some output depends on (outputs included, inputs excluded)."""
+    """Nodes some output depends on (outputs included, inputs excluded).
+
+    A walk back from the outputs over each edge once: linear in nodes and edges.
+    """
+    sources: dict[int, list[int]] = {}
+    for a, b in edges:
+        sources.setdefault(b, []).append(a)
     needed = set(outputs)
-    frontier = set(outputs)
-    while frontier:
-        sources = {a for a, b in edges if b in frontier and a not in needed and a not in inputs}
-        needed |= sources
-        frontier = sources
+    stack = list(outputs)
+    while stack:
+        for a in sources.get(stack.pop(), ()):
+            if a not in needed and a not in inputs:
+                needed.add(a)
+                stack.append(a)
     return needed
+
+
+def topological_order(needed: set[int], edges: list[tuple[int, int]]) -> list[int]:
+    """The needed nodes in waves of Kahn's algorithm, each wave sorted by key.
+
+    Iterative and linear in edges (plus the sorting of each wave), so a chain of any
+    length cannot exhaust the stack or take quadratic time. In a DAG every order gives
+    the same values; sorting makes it deterministic.
+
+    Raises:
+        NetworkError: the needed nodes form a cycle.
+    """
+    targets: dict[int, list[int]] = {n: [] for n in needed}
+    indegree = dict.fromkeys(needed, 0)
+    for a, b in set(edges):  # a repeated edge is one dependency
+        if a in needed and b in needed:
+            targets[a].append(b)
+            indegree[b] += 1
+    wave = sorted(n for n, d in indegree.items() if d == 0)
+    order: list[int] = []
+    while wave:
+        order.extend(wave)
+        ready = []
+        for a in wave:
+            for b in targets[a]:
+                indegree[b] -= 1
+                if indegree[b] == 0:
+                    ready.append(b)
+        wave = sorted(ready)
+    if len(order) < len(needed):
+        stuck = min(n for n, d in indegree.items() if d > 0)
+        raise NetworkError(
+            f"the network has a cycle (through node {stuck}); only feed-forward networks run here"
+        )
+    return order
 
 
 def _compile(spec: NetworkSpec) -> CompiledNetwork:
@@ -413,16 +471,7 @@ def _compile(spec: NetworkSpec) -> CompiledNetwork:
         idle = sorted(n for n in needed if n not in targets)
         return _arrays(spec, nodes, inputs, outputs, order, idle, enabled, needed)
 
-    # Topological order of the needed nodes (Kahn), ready nodes by key for determinism:
-    # in a DAG every order gives the same values.
-    preds = {n: {a for a, b in edges if b == n and a in needed} for n in needed}
-    order, done = [], set()
-    while len(order) < len(needed):
-        ready = sorted(n for n in needed if n not in done and preds[n] <= done)
-        if not ready:
-            raise NetworkError("the network has a cycle; only feed-forward networks run here")
-        order.extend(ready)
-        done.update(ready)
+    order = topological_order(needed, edges)
     return _arrays(spec, nodes, inputs, outputs, order, [], enabled, needed)
 
 
@@ -433,11 +482,14 @@ def _arrays(spec, nodes, inputs, outputs, order, idle, enabled, needed) -> Compi
     slots.update({k: len(inputs) + i for i, k in enumerate(outputs)})
     for k in [*order, *idle]:
         slots.setdefault(k, len(slots))
+    incoming: dict[int, list[ConnectionSpec]] = {}
+    for c in enabled:  # grouped by target in one pass, each group in file order
+        incoming.setdefault(c.target, []).append(c)
     link_start, link_source, link_weight = [0], [], []
     for k in order:
         # Links in file order: the same summation order as neat-python.
-        for c in enabled:
-            if c.target == k and (c.source in needed or c.source in input_set):
+        for c in incoming.get(k, ()):
+            if c.source in needed or c.source in input_set:
                 link_source.append(slots[c.source])
                 link_weight.append(c.weight)
         link_start.append(len(link_source))

@@ -36,22 +36,24 @@ import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.json_files import load_json_file
+from evorbc_ros.limits import PRIMITIVES
+from evorbc_ros.repertoire_checks import (
+    QUALITY_RANGES,
+    ColumnError,
+    archive_problem,
+    contents_problem,
+    number_column,
+    version_problem,
+)
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.primitive import GENE_HIGH, GENE_LOW, ParameterSpec
 
 FORMAT = "evorbc-repertoire"
 VERSION = 1
 
-#: Names of the quality metrics. They are defined in offline_evolution.quality, which this
-#: onboard package must not import; a test keeps the two lists equal.
-METRICS = (
-    "circular",
-    "radial",
-    "distance",
-    "distance+circular",
-    "distance+radial",
-    "circular+tilt",
-)
+#: Names of the quality metrics, with their ranges in repertoire_checks.QUALITY_RANGES
+#: (offline_evolution.quality defines the metrics and takes their ranges from there).
+METRICS = tuple(QUALITY_RANGES)
 
 
 class RepertoireError(ValueError):
@@ -192,12 +194,9 @@ class Repertoire:
             raise RepertoireError(
                 f"{source}: not a repertoire file (format is {fmt!r}, expected {FORMAT!r})"
             )
-        version = data.get("version")
-        if version != VERSION:
-            raise RepertoireError(
-                f"{source}: repertoire format version {version!r} is not "
-                f"supported (this evorbc reads version {VERSION})"
-            )
+        problem = version_problem(data.get("version"), "repertoire", VERSION)
+        if problem:
+            raise RepertoireError(f"{source}: {problem}")
         try:
             prims = _require(data, "primitives", dict, source)
             params = _require(data, "parameters", list, source)
@@ -213,15 +212,7 @@ class Repertoire:
                         high=float(_require(p, "high", (int, float), source, f"parameters[{k}].")),
                     )
                 )
-            arrays = {}
-            for key in ("genes", "behaviour", "heading", "quality"):
-                value = _require(prims, key, list, source, "primitives.")
-                try:
-                    arrays[key] = np.asarray(value, dtype=np.float64)
-                except (ValueError, TypeError):
-                    raise RepertoireError(
-                        f"{source}: primitives.{key} must be a rectangular array of numbers"
-                    ) from None
+            arrays = _columns(prims, source)
             if len(arrays["quality"]) == 0:
                 arrays["genes"] = arrays["genes"].reshape(0, len(parameters))
                 arrays["behaviour"] = arrays["behaviour"].reshape(0, 2)
@@ -323,38 +314,6 @@ def robot_problem(robot: Any, n_parameters: int | None = None) -> str | None:
     return None
 
 
-def _archive_problem(archive: dict) -> str | None:
-    """The first problem with the archive layout (offline_evolution.repertoire.archive)."""
-    if not archive:
-        return None  # a repertoire made in memory without one: nothing reads it
-    kind = archive.get("kind")
-    if kind not in ("grid", "cvt"):
-        return f"archive.kind must be grid or cvt, got {reprlib.repr(kind)}"
-    for key in ("low", "high"):
-        value = archive.get(key)
-        if not (isinstance(value, list) and len(value) == 2 and all(map(_finite, value))):
-            return f"archive.{key} must be 2 finite numbers (m), got {reprlib.repr(value)}"
-    if not all(lo < hi for lo, hi in zip(archive["low"], archive["high"], strict=True)):
-        return "archive.low must be below archive.high"
-    if kind == "grid":
-        dims = archive.get("dims")
-        if not (isinstance(dims, list) and len(dims) == 2 and all(map(_positive_int, dims))):
-            return f"archive.dims must be 2 positive integers, got {reprlib.repr(dims)}"
-    elif not _positive_int(archive.get("cells")):
-        return f"archive.cells must be a positive integer, got {reprlib.repr(archive.get('cells'))}"
-    return None
-
-
-def _positive_int(value: Any) -> bool:
-    """A JSON integer (not a boolean) > 0."""
-    return isinstance(value, int) and not isinstance(value, bool) and value > 0
-
-
-def _finite(value: Any) -> bool:
-    """A JSON number (not a boolean) that is finite."""
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
 def _problem(r: Repertoire) -> str | None:
     """The first problem with robot, metric, shapes, finiteness or ranges, or None."""
     n = r.quality.shape[0] if r.quality.ndim == 1 else -1
@@ -383,9 +342,12 @@ def _problem(r: Repertoire) -> str | None:
         ),
         (
             math.isfinite(r.eval_time) and r.eval_time > 0,
-            f"eval_time must be > 0 s, got {r.eval_time}",
+            f"eval_time must be > 0 s, got {r.eval_time!r}",
         ),
-        (math.isfinite(r.bin_size) and r.bin_size > 0, f"bin_size must be > 0 m, got {r.bin_size}"),
+        (
+            math.isfinite(r.bin_size) and r.bin_size > 0,
+            f"bin_size must be > 0 m, got {r.bin_size!r}",
+        ),
     ]
     for ok, message in checks:
         if not ok:
@@ -405,4 +367,22 @@ def _problem(r: Repertoire) -> str | None:
     simulation = r.algorithm.get("simulation")  # compared key by key with the robot's
     if simulation is not None and not isinstance(simulation, dict):
         return f"algorithm.simulation must be a mapping, got {reprlib.repr(simulation)}"
-    return _archive_problem(r.archive)
+    return archive_problem(r.archive, r.bin_size) or contents_problem(r)
+
+
+def _columns(prims: dict, source: str) -> dict[str, np.ndarray]:
+    """The four columns of ``primitives`` as arrays, counted before they are converted.
+
+    The count comes from the lists' lengths, so a file of millions of primitives is
+    refused (over :data:`~evorbc_ros.limits.PRIMITIVES`) before any per-primitive work.
+    """
+    lists = {key: _require(prims, key, list, source, "primitives.") for key in _COLUMNS}
+    PRIMITIVES.check(max(map(len, lists.values())), source, RepertoireError, "in the file")
+    try:
+        return {key: number_column(lists[key], key, rows) for key, rows in _COLUMNS.items()}
+    except ColumnError as e:
+        raise RepertoireError(f"{source}: {e}") from None
+
+
+#: The columns of ``primitives`` and whether each is a list of rows (or of numbers).
+_COLUMNS = {"genes": True, "behaviour": True, "heading": False, "quality": False}

@@ -55,10 +55,12 @@ from offline_evolution.arbitrator.selection import (
     validation_rows,
 )
 from offline_evolution.arbitrator.warm_start import network_fingerprint, seed_population
+from offline_evolution.checkpoint import VERSION as CHECKPOINT_VERSION
 from offline_evolution.checkpoint import (
     CheckpointError,
     Interrupted,
     check_same_robot,
+    check_version,
     load_json_checkpoint,
     settings_mismatch,
 )
@@ -513,6 +515,7 @@ class Evolution:
         """Write a JSON checkpoint between generations (atomically)."""
         data = {
             "kind": CHECKPOINT_KIND,
+            "version": CHECKPOINT_VERSION,
             "settings": self.settings.as_dict(),
             "population": population_to_dict(self.population),
             "best": self.best,
@@ -540,6 +543,7 @@ class Evolution:
         data = load_json_checkpoint(path)
         if data.get("kind") != CHECKPOINT_KIND:
             raise CheckpointError(f"{path}: not a NEAT evolution checkpoint", discardable=False)
+        check_version(data, str(path))
         if not isinstance(data.get("settings"), dict):
             raise CheckpointError(f"{path}: not a usable checkpoint (settings missing)")
         # Selection settings never change the population, and a file's location never
@@ -597,6 +601,9 @@ class Evolution:
                 require(g, "fitness", float, f"hall_of_fame.{part}[{i}].")
                 if part == "nominal":
                     require(g, "nominal_fitness", float, f"hall_of_fame.{part}[{i}].")
+        size = require(hall, "size", int, "hall_of_fame.")
+        if size < 1:
+            raise ValueError(f"hall_of_fame.size must be 1 or more, got {size}")
         self.hall = HallOfFame.from_dict(hall)
         history = require(data, "history", list)
         if len(history) != generation:
@@ -615,7 +622,10 @@ class Evolution:
             self.final_scores = PostScores.from_dict(
                 require(data, "post_final_scores", dict), where
             )
-        return float(require(data, "elapsed", float))
+        elapsed = float(require(data, "elapsed", float))
+        if elapsed < 0:
+            raise ValueError(f"elapsed must be 0 s or more, got {elapsed}")
+        return elapsed
 
 
 def evolve(

@@ -21,6 +21,9 @@ import neat
 from neat.attributes import BoolAttribute, FloatAttribute, StringAttribute
 from neat.species import Species
 
+from evorbc_ros.limits import NETWORK_CONNECTIONS, NETWORK_NODES
+from evorbc_ros.network import NetworkError, topological_order
+
 _KINDS = {int: "a whole number", float: "a number", str: "a string", bool: "true or false"}
 _KINDS.update({list: "a list", dict: "an object"})
 
@@ -65,6 +68,10 @@ def check_genome_dict(data: dict, config: neat.Config, where: str = "genome.") -
     gc = config.genome_config
     require(data, "key", int, where)
     require(data, "fitness", float, where, none_ok=True)
+    for limit, part in ((NETWORK_NODES, "nodes"), (NETWORK_CONNECTIONS, "connections")):
+        problem = limit.problem(len(require(data, part, list, where)), f"in {where}{part}")
+        if problem:
+            raise ValueError(problem)
     nodes = set()
     for part, gene_type in (("nodes", gc.node_gene_type), ("connections", gc.connection_gene_type)):
         for i, gene in enumerate(require(data, part, list, where)):
@@ -85,6 +92,14 @@ def check_genome_dict(data: dict, config: neat.Config, where: str = "genome.") -
     missing = set(gc.output_keys) - nodes
     if missing:
         raise ValueError(f"{where}nodes lacks the output nodes {sorted(missing)}")
+    if gc.feed_forward:
+        # neat-python never adds a connection that closes a cycle to a feed-forward
+        # genome (disabled ones included: mutation may enable them again).
+        edges = [tuple(c["key"]) for c in data["connections"]]
+        try:
+            topological_order(nodes, edges)
+        except NetworkError as e:
+            raise ValueError(f"{where}connections: {e}") from None
 
 
 def genome_to_dict(genome) -> dict:
@@ -207,6 +222,58 @@ def _check_population_dict(data: dict) -> None:
         raise ValueError(f"{w}generation must not be negative, got {data['generation']}")
 
 
+def _check_consistency(data: dict, genomes: dict) -> None:
+    """What a population needs besides well-formed parts: species, members and counters.
+
+    Every genome is in exactly one species (so there is at least one), the species map
+    says so too, and each counter is past every key in use: a new genome, species or
+    node must not take the key of an existing one.
+
+    Raises:
+        ValueError: naming the first entry that breaks one of these.
+    """
+    w = "population."
+    species = data["species"]
+    if genomes and not species:
+        raise ValueError(f"{w}species is empty, but every genome belongs to a species")
+    home: dict[int, int] = {}
+    for i, s in enumerate(species):
+        members = s["members"]
+        if not members:
+            raise ValueError(f"{w}species[{i}].members is empty")
+        unknown = {s["representative"], *members} - set(genomes)
+        if unknown:
+            raise ValueError(f"{w}species[{i}] holds genomes not in the population")
+        if len(set(members)) != len(members):
+            raise ValueError(f"{w}species[{i}].members lists a genome twice")
+        for g in members:
+            if home.setdefault(g, s["key"]) != s["key"]:
+                raise ValueError(f"{w}genome {g} is in more than one species")
+        for k, f in enumerate(s["fitness_history"]):
+            if isinstance(f, bool) or not isinstance(f, (int, float)) or not math.isfinite(f):
+                raise ValueError(f"{w}species[{i}].fitness_history[{k}] must be a number")
+    homeless = sorted(set(genomes) - set(home))
+    if homeless:
+        raise ValueError(f"{w}genome {homeless[0]} is in no species")
+    if len({s["key"] for s in species}) != len(species):
+        raise ValueError(f"{w}species keys must be unique")
+    try:
+        mapped = {g: s for g, s in data["genome_to_species"]}
+    except (TypeError, ValueError):
+        raise ValueError(f"{w}genome_to_species must list [genome, species] pairs") from None
+    if mapped != home:
+        raise ValueError(f"{w}genome_to_species disagrees with the species' members")
+    counters = {
+        "next_genome_key": max(genomes, default=None),
+        "next_species_key": max(home.values(), default=None),
+        "next_node_key": max((n["key"] for g in data["genomes"] for n in g["nodes"]), default=None),
+    }
+    for key, used in counters.items():
+        value = data[key]
+        if value is not None and used is not None and value <= used:
+            raise ValueError(f"{w}{key} is {value}, but key {used} is already in use")
+
+
 def population_from_dict(data: dict, config: neat.Config) -> neat.Population:
     """Rebuild a population written by :func:`population_to_dict` (with the same config).
 
@@ -220,12 +287,12 @@ def population_from_dict(data: dict, config: neat.Config) -> neat.Population:
     genomes = {}
     for i, g in enumerate(require(data, "genomes", list, "population.")):
         genome = genome_from_dict(g, config, f"population.genomes[{i}].")
+        if genome.key in genomes:
+            raise ValueError(f"population.genomes[{i}].key {genome.key} is used twice")
         genomes[genome.key] = genome
+    _check_consistency(data, genomes)
     species_set = config.species_set_type(config.species_set_config, neat.reporting.ReporterSet())
-    for i, s in enumerate(data["species"]):
-        unknown = {s["representative"], *s["members"]} - set(genomes)
-        if unknown:
-            raise ValueError(f"population.species[{i}] holds genomes not in the population")
+    for s in data["species"]:
         species = Species(s["key"], s["created"])
         species.last_improved = s["last_improved"]
         species.representative = genomes[s["representative"]]

@@ -183,7 +183,7 @@ def _identity(path: str | os.PathLike):
     try:
         st = os.stat(path)
     except OSError:
-        return Path(path).resolve()
+        return Path(os.path.realpath(path))  # no RuntimeError on a symlink loop
     return (st.st_dev, st.st_ino)
 
 

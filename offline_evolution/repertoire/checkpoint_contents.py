@@ -53,8 +53,9 @@ def arrays_problem(
     for name in ("solution", "objective", "measures", "heading"):
         if name not in arrays:
             return f"{name} is missing"
-        if not np.issubdtype(arrays[name].dtype, np.number):
-            return f"{name} must hold numbers, got {arrays[name].dtype}"
+        # A run writes float64 here: complex, integer or string arrays are no checkpoint's.
+        if arrays[name].dtype.kind != "f":
+            return f"{name} must hold real numbers (float), got {arrays[name].dtype}"
     n = len(arrays["objective"]) if arrays["objective"].ndim == 1 else -1
     expected = {"solution": (n, n_genes), "objective": (n,), "measures": (n, 2), "heading": (n,)}
     for name, shape in expected.items():

@@ -23,6 +23,7 @@ import ribs
 
 from evorbc_ros.config import build_settings
 from evorbc_ros.repertoire import Repertoire
+from evorbc_ros.repertoire_checks import HEADING_LIMIT, QUALITY_RANGES
 from evorbc_ros.robots.primitive import GENE_HIGH, GENE_LOW, ParameterSpec
 from offline_evolution.checkpoint import (
     CheckpointError,
@@ -212,7 +213,9 @@ class MapElites:
                 winding (recorded in the repertoire and drawn in its picture).
 
         Raises:
-            ValueError: arrays of the wrong shape, genes outside [-1, 1] or not finite.
+            ValueError: arrays of the wrong shape, genes outside [-1, 1] or not finite, a
+                quality outside ``settings.metric``'s range or a heading beyond 1000 rad
+                (a repertoire file could not hold them, docs/design.md section 12).
             SettingError: the metric does not suit the robot's outcome.
 
         """
@@ -223,6 +226,7 @@ class MapElites:
         genes, quality, behaviour, heading = _told(
             genes, quality, behaviour, heading, len(self.parameters)
         )
+        _check_told_values(quality, heading, self.settings.metric)
         inside = np.all((behaviour >= self._low) & (behaviour < self._high), axis=1)
         keep = np.isfinite(quality) & inside
         self.archive.add(
@@ -474,6 +478,16 @@ def _told(genes, quality, behaviour, heading, d: int) -> tuple[np.ndarray, ...]:
     if n and not (genes.min() >= GENE_LOW and genes.max() <= GENE_HIGH):
         raise ValueError(f"tell(): genes must be finite and lie in [{GENE_LOW}, {GENE_HIGH}]")
     return genes, quality, behaviour, heading
+
+
+def _check_told_values(quality: np.ndarray, heading: np.ndarray, metric: str) -> None:
+    """Refuse at :meth:`MapElites.tell` what the repertoire file would refuse at the end."""
+    low, high = QUALITY_RANGES[metric]
+    kept = np.isfinite(quality)  # NaN discards a primitive (a legged robot that fell)
+    if kept.any() and (quality[kept].min() < low or quality[kept].max() > high):
+        raise ValueError(f"tell(): quality must lie in [{low:g}, {high:g}] for metric {metric}")
+    if kept.any() and not np.abs(heading[kept]).max() <= HEADING_LIMIT:
+        raise ValueError(f"tell(): heading must be finite and within +-{HEADING_LIMIT:g} rad")
 
 
 def make_emitter(archive, settings: MapElitesSettings) -> PaperMutationEmitter:
