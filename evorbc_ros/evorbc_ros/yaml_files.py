@@ -14,7 +14,6 @@ Python, which is where the checks are made (measured in docs/performance.md).
 
 from __future__ import annotations
 
-import gc
 from collections.abc import Mapping
 from typing import Any
 
@@ -32,6 +31,7 @@ from yaml.events import (
 from yaml.nodes import MappingNode, ScalarNode, SequenceNode
 from yaml.resolver import Resolver
 
+from evorbc_ros.input_files import gc_paused
 from evorbc_ros.limits import NESTING, Limit
 
 try:  # libyaml's parser: the same events as pyyaml's, several times faster
@@ -193,13 +193,9 @@ def parse_yaml(
         document too large for memory.
     """
     loader = _StrictLoader(text, source, error, counts or {})
-    # The cyclic garbage collector would walk every node and value built so far, again and
-    # again as they accumulate: two thirds of the time of a 200,000-wall maze. Parsing
-    # makes no cycles, so it is paused for the parse (docs/performance.md).
-    collecting = gc.isenabled()
-    gc.disable()
     try:
-        return loader.get_single_data()
+        with gc_paused():
+            return loader.get_single_data()
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
@@ -208,8 +204,6 @@ def parse_yaml(
     except RecursionError:  # only with a recursion limit set far below NESTING's
         raise error(f"{source}: invalid YAML: nested too deeply") from None
     except MemoryError:
-        raise error(f"{source}: too large to load (out of memory)") from None
+        raise error(f"{source}: cannot parse: the file does not fit in memory") from None
     finally:
-        if collecting:
-            gc.enable()
         loader.dispose()

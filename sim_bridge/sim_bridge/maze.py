@@ -272,9 +272,9 @@ def load_named_maze(name_or_path: str) -> Maze:
     """A shipped maze by name, or any maze file by path."""
     if name_or_path.endswith((".yaml", ".yml")) or os.sep in name_or_path:
         return load_maze(name_or_path)
-    path = maze_dir() / f"{name_or_path}.yaml"
-    if not path.exists():
-        raise ConfigError(
-            f"unknown maze {name_or_path!r}; shipped mazes: {', '.join(maze_names())}"
-        )
-    return load_maze(path)
+    # A name is looked up among the shipped ones, never joined into a path: a 300-letter
+    # name would otherwise fail in the file system (ENAMETOOLONG), not as an unknown maze.
+    names = maze_names()
+    if name_or_path not in names:
+        raise ConfigError(f"unknown maze {name_or_path!r}; shipped mazes: {', '.join(names)}")
+    return load_maze(maze_dir() / f"{name_or_path}.yaml")
