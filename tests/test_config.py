@@ -44,14 +44,22 @@ def test_unknown_key_suggests_the_right_one(tmp_path):
     assert "did you mean 'bin_size'" in error_for(tmp_path, BASE + "bin_sise: 0.02\n")
 
 
+def with_setting(line: str) -> str:
+    """BASE with ``line`` (``key: value``) in place of its key's line, if it has one."""
+    key = line.split(":")[0]
+    kept = [k for k in BASE.splitlines(keepends=True) if not k.startswith(f"{key}:")]
+    return "".join(kept) + line + "\n"
+
+
 def test_wrong_type_and_range(tmp_path):
-    assert "batch_size must be an integer" in error_for(tmp_path, BASE + "batch_size: 1.5\n")
-    assert "bin_size must be >= 0.0001" in error_for(tmp_path, BASE + "bin_size: -1\n")
-    assert "mutation_probability must be <= 1" in error_for(
-        tmp_path, BASE + "mutation_probability: 2\n"
-    )
-    assert "metric must be one of" in error_for(tmp_path, BASE + "metric: curvy\n")
-    assert "seed must be an integer" in error_for(tmp_path, BASE + "seed: true\n")
+    def error(line):
+        return error_for(tmp_path, with_setting(line))
+
+    assert "batch_size must be an integer" in error("batch_size: 1.5")
+    assert "bin_size must be >= 0.0001" in error("bin_size: -1")
+    assert "mutation_probability must be <= 1" in error("mutation_probability: 2")
+    assert "metric must be one of" in error("metric: curvy")
+    assert "seed must be an integer" in error("seed: true")
 
 
 def test_missing_key_and_wrong_top_level(tmp_path):

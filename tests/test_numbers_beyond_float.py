@@ -88,7 +88,8 @@ def test_settings_files_with_an_integer_beyond_float_range(tmp_path, capsys):
 def test_an_integer_setting_beyond_int64_is_refused(tmp_path, capsys):
     config = tmp_path / "rep.yaml"
     shipped = (config_dir() / "repertoire" / "4ws.yaml").read_text()
-    config.write_text(shipped + "seed: 100000000000000000000000\n")
+    seed = next(line for line in shipped.splitlines() if line.startswith("seed:"))
+    config.write_text(shipped.replace(seed, "seed: 100000000000000000000000"))
     err = one_line_error(capsys, "repertoire", "--config", config, "--out", tmp_path / "r.json")
     assert "seed must be at most 9,223,372,036,854,775,807 in size" in err
 

@@ -17,13 +17,14 @@ import os
 import sys
 import types
 import typing
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular_text
 from evorbc_ros.json_files import find_value
+from evorbc_ros.limits import Limit
+from evorbc_ros.yaml_files import parse_yaml
 
 #: The largest integer a float can hold; a larger one cannot be any setting.
 _FLOAT_MAX_INT = int(sys.float_info.max)
@@ -35,26 +36,24 @@ class ConfigError(ValueError):
     """A settings file or value is not valid; the message names the file and key."""
 
 
-def load_yaml_mapping(path: str | os.PathLike) -> dict[str, Any]:
+def load_yaml_mapping(
+    path: str | os.PathLike, counts: Mapping[str, Limit] | None = None
+) -> dict[str, Any]:
     """Read a YAML file whose top level is a mapping.
+
+    Args:
+        counts: limits on the items of top-level lists, by key (a maze's ``walls``),
+            checked from the count before the items are built.
 
     Raises:
         ConfigError: the file is missing, not a regular file, too large, not UTF-8, not
-            YAML, or not a mapping.
+            YAML, or not a mapping; or it holds an anchor, alias or merge key, a key given
+            twice or nesting too deep (:func:`evorbc_ros.yaml_files.parse_yaml`).
 
     """
     source = str(path)
     text = read_regular_text(path, "settings", ConfigError, SETTINGS_LIMIT)
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(e, "problem", None) or "invalid YAML"
-        raise ConfigError(f"{source}: invalid YAML{where}: {problem}") from None
-    except RecursionError:
-        # The parser recurses once per nesting level; no settings file nests this deeply.
-        raise ConfigError(f"{source}: invalid YAML: nested too deeply") from None
+    data = parse_yaml(text, source, ConfigError, counts)
     if data is None:
         return {}
     if not isinstance(data, dict):

@@ -14,9 +14,11 @@ import os
 import re
 import reprlib
 import sys
+from itertools import chain
 from typing import Any
 
-from evorbc_ros.input_files import DATA_LIMIT, read_regular_text
+from evorbc_ros.input_files import DATA_LIMIT, gc_paused, read_regular_text
+from evorbc_ros.limits import NESTING
 
 
 def load_json_file(
@@ -42,8 +44,10 @@ def load_json_file(
 
 #: The largest integer a float can hold (to within rounding): larger ones overflow.
 _FLOAT_MAX_INT = int(sys.float_info.max)
-#: An exponent of 100 or more: the only floats that may be beyond float range.
-_BIG_EXPONENT = re.compile(r"[eE]\+?0*[1-9]\d\d")
+#: An exponent of 100 or more: the only floats that may be beyond float range. One
+#: pattern per letter: a pattern that starts with a literal is searched for nine times as
+#: fast as one that starts with ``[eE]`` (0.05 s for 92 MB, docs/performance.md).
+_BIG_EXPONENTS = (re.compile(r"e\+?0*[1-9]\d\d"), re.compile(r"E\+?0*[1-9]\d\d"))
 
 
 class _BeyondFloat:
@@ -55,12 +59,62 @@ class _BeyondFloat:
         self.text = text
 
 
+class _Duplicated(dict):
+    """An object in which ``key`` appears twice, kept until its key path is found."""
+
+    __slots__ = ("key",)
+
+
+def duplicate_key_hook(found: list):
+    """An ``object_pairs_hook`` that marks an object in which a key appears twice.
+
+    The marked object is appended to ``found`` too, so that the data is searched for its
+    key path only when there is one.
+    """
+
+    def pairs(items: list) -> dict:
+        obj = dict(items)
+        if len(obj) == len(items):
+            return obj
+        seen = set()
+        marked = _Duplicated(obj)
+        marked.key = next(k for k, _ in items if k in seen or seen.add(k))
+        found.append(marked)
+        return marked
+
+    return pairs
+
+
+#: A ``\uD800``-``\uDFFF`` escape: the only way a lone surrogate gets into decoded text.
+_SURROGATE_ESCAPE = re.compile(r"\\u[dD][89a-fA-F]")
+
+
+def _lone_surrogate(value: Any) -> bool:
+    """Whether ``value`` is text holding a lone surrogate, or an object with such a key."""
+    if isinstance(value, dict):
+        return any(isinstance(k, str) and _lone_surrogate(k) for k in value)
+    if not isinstance(value, str):
+        return False
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError:
+        return True
+    return False
+
+
 def parse_json(text: str, source: str, what: str, error: type[Exception], range_error=None) -> Any:
-    """Parse JSON ``text`` read from ``source`` (see :func:`load_json_file` for errors).
+    r"""Parse JSON ``text`` read from ``source`` (see :func:`load_json_file` for errors).
+
+    Besides invalid JSON, refused in one line naming the key path: a key that appears
+    twice in one object (JSON keeps the last silently), text with a lone surrogate (a
+    ``"\ud800"`` escape; such text cannot be printed or written as UTF-8), a number
+    beyond float range, and nesting deeper than :data:`evorbc_ros.limits.NESTING`.
 
     Args:
-        range_error: what to raise for a number beyond float range (default ``error``).
+        range_error: what to raise for a value the file holds but no writer makes (a
+            number beyond float range, a key twice, a lone surrogate); default ``error``.
     """
+    refuse = range_error or error
     seen = []
 
     def parse_int(digits: str):
@@ -80,12 +134,15 @@ def parse_json(text: str, source: str, what: str, error: type[Exception], range_
 
     # A hook costs a Python call per number. Integers are few in our files (counts,
     # keys, seeds); floats are many, and only one with an exponent of 100 or more can
-    # overflow, which a quick search rules out.
-    hooks = {"parse_int": parse_int}
-    if _BIG_EXPONENT.search(text):
+    # overflow, which a quick search rules out. Objects are few too (columns are lists):
+    # the duplicate-key hook costs little (docs/performance.md).
+    duplicated = []
+    hooks = {"parse_int": parse_int, "object_pairs_hook": duplicate_key_hook(duplicated)}
+    if any(p.search(text) for p in _BIG_EXPONENTS):
         hooks["parse_float"] = parse_float
     try:
-        data = json.loads(text, **hooks)
+        with gc_paused():
+            data = json.loads(text, **hooks)
     except RecursionError:
         # The decoder recurses once per nesting level; no file of ours nests this deeply.
         raise error(f"{source}: corrupt {what} file (invalid JSON: nested too deeply)") from None
@@ -95,13 +152,73 @@ def parse_json(text: str, source: str, what: str, error: type[Exception], range_
             f"{source}: {kind} {what} file (invalid JSON at line {e.lineno}, "
             f"column {e.colno}: {e.msg})"
         ) from None
+    except MemoryError:
+        raise error(f"{source}: cannot parse: the {what} file does not fit in memory") from None
+    depth = nesting_depth(data)
+    if depth > _bound(source, error):
+        raise error(f"{source}: corrupt {what} file: {NESTING.problem(depth)}")
+    if duplicated:
+        where, obj = find_value(data, lambda v: isinstance(v, _Duplicated))
+        raise refuse(f"{source}: key {_path(where, obj.key)!r} appears twice")
+    if _SURROGATE_ESCAPE.search(text):
+        found = find_value(data, _lone_surrogate)
+        if found:
+            where, value = found
+            name = "text"
+            if isinstance(value, dict):
+                name, value = "a key", next(k for k in value if _lone_surrogate(k))
+            raise refuse(
+                f"{source}: {where or 'the top level'}: {name} with a lone surrogate "
+                f"({ascii(value)[:60]}), which is no character; expected UTF-8 text"
+            )
     if seen:
         where, number = find_value(data, lambda v: isinstance(v, _BeyondFloat))
-        raise (range_error or error)(
+        raise refuse(
             f"{source}: {where or 'the top level'}: {reprlib.repr(number.text)} is beyond "
             "float range (at most about 1.8e308)"
         )
     return data
+
+
+def _path(where: str, key: str) -> str:
+    name = key if key.isidentifier() else json.dumps(key)
+    return f"{where}.{name}" if where else name
+
+
+def _bound(source: str, error: type[Exception]) -> int:
+    try:
+        return NESTING.value()
+    except ValueError as e:  # its environment variable is not a positive integer
+        raise error(f"{source}: {e}") from None
+
+
+_CONTAINERS = (list, dict, _Duplicated)
+
+
+def nesting_depth(data: Any) -> int:
+    """How many lists and objects deep ``data`` nests (0 for a number or text).
+
+    Level by level, with the iteration in C (``chain``, ``map(type, ...)``): the 4 million
+    numbers of a 200,000-primitive repertoire's columns cost one pass, not a Python call
+    each (docs/performance.md).
+    """
+    if data.__class__ not in _CONTAINERS:
+        return 0
+    depth = 0
+    level = [data]
+    while True:
+        depth += 1
+        kinds = set(map(type, _children(level)))  # the deepest level is never listed
+        if list not in kinds and dict not in kinds and _Duplicated not in kinds:
+            return depth
+        level = [v for v in _children(level) if v.__class__ in _CONTAINERS]
+
+
+def _children(level: list):
+    """The items of the lists and the values of the objects in ``level``, lazily."""
+    lists = [v for v in level if v.__class__ is list]
+    dicts = [v for v in level if v.__class__ is not list]
+    return chain(chain.from_iterable(lists), chain.from_iterable(map(dict.values, dicts)))
 
 
 def find_value(data: Any, wanted, where: str = "") -> tuple[str, Any] | None:

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from evorbc_ros.config import ConfigError, config_dir, load_yaml_mapping
+from evorbc_ros.limits import MAZE_WALLS
 from sim_bridge.geometry import WallGrid, box_corners, box_distances, clearance, wall_boxes
 
 _KEYS = {"name", "description", "wall_thickness", "walls", "start", "target", "target_radius"}
@@ -190,6 +191,8 @@ def maze_from_dict(data: dict, source: str) -> Maze:
     walls = data["walls"]
     if not isinstance(walls, list) or not walls:
         raise ConfigError(f"{source}: walls must be a non-empty list of [x1, y1, x2, y2]")
+    # From the count, before any geometry: checking and simulating cost time in the walls.
+    MAZE_WALLS.check(len(walls), source, ConfigError, "in walls")
     segments = np.array([_numbers(w, 4, f"walls[{k}]", source) for k, w in enumerate(walls)])
     lengths = np.hypot(segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1])
     if np.any(lengths <= 0):
@@ -252,7 +255,7 @@ def _only(mapping: dict, keys: set[str], where: str, source: str) -> None:
 
 def load_maze(path: str | os.PathLike) -> Maze:
     """Load and validate a maze file (see the module docstring for the layout)."""
-    return maze_from_dict(load_yaml_mapping(path), str(path))
+    return maze_from_dict(load_yaml_mapping(path, {"walls": MAZE_WALLS}), str(path))
 
 
 def maze_dir() -> Path:
@@ -269,9 +272,9 @@ def load_named_maze(name_or_path: str) -> Maze:
     """A shipped maze by name, or any maze file by path."""
     if name_or_path.endswith((".yaml", ".yml")) or os.sep in name_or_path:
         return load_maze(name_or_path)
-    path = maze_dir() / f"{name_or_path}.yaml"
-    if not path.exists():
-        raise ConfigError(
-            f"unknown maze {name_or_path!r}; shipped mazes: {', '.join(maze_names())}"
-        )
-    return load_maze(path)
+    # A name is looked up among the shipped ones, never joined into a path: a 300-letter
+    # name would otherwise fail in the file system (ENAMETOOLONG), not as an unknown maze.
+    names = maze_names()
+    if name_or_path not in names:
+        raise ConfigError(f"unknown maze {name_or_path!r}; shipped mazes: {', '.join(names)}")
+    return load_maze(maze_dir() / f"{name_or_path}.yaml")
