@@ -625,3 +625,20 @@ def test_exactly_one_tiling_sector_lights_near_every_edge():
         assert compiled.tiling_sector(b, first, width, n) == int(
             np.argmax(goal_sector_readings(b, gs))
         )
+
+
+@pytest.mark.parametrize(
+    ("change", "needle"),
+    [
+        ({"range": 300.0}, "rangefinders.range must be a number > 0 and <= 50"),
+        ({"rays": 10**6, "field_of_view_deg": 30.0}, "rays must be an integer from 1 to 100"),
+        ({"angles_deg": [0.0] * 361}, "angles_deg must be a list of 1 to 360 numbers"),
+    ],
+)
+def test_a_layout_that_would_exhaust_the_machine_is_refused(change, needle):
+    # A 300 m range (a fuzzed layout swapped a beam angle into it) asked for 1.4 GiB of
+    # lookup table at once: an internal error, not a refusal.
+    data = yaml.safe_load((config_dir() / "sensors" / "4ws.yaml").read_text())
+    data["rangefinders"].update(change)
+    with pytest.raises(ConfigError, match=re.escape(needle)):
+        SensorLayout.from_dict(data, "layout.yaml")

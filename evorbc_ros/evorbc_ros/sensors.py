@@ -190,11 +190,15 @@ class SensorLayout:
             )
             angles = _number_list(d.get("angles_deg"), "rangefinders.angles_deg", source)
             rays = d.get("rays", 1)
-            if isinstance(rays, bool) or not isinstance(rays, int) or rays < 1:
-                raise ConfigError(f"{source}: rangefinders.rays must be an integer >= 1")
+            if isinstance(rays, bool) or not isinstance(rays, int) or not 1 <= rays <= MAX_RAYS:
+                raise ConfigError(
+                    f"{source}: rangefinders.rays must be an integer from 1 to {MAX_RAYS}"
+                )
             rf = RangefinderLayout(
                 angles=tuple(math.radians(a) for a in angles),
-                max_range=_positive(d.get("range"), "rangefinders.range", source),
+                max_range=_positive(
+                    d.get("range"), "rangefinders.range", source, maximum=MAX_RANGE
+                ),
                 mount_radius=_positive(
                     d.get("mount_radius", 0.0), "rangefinders.mount_radius", source, allow_zero=True
                 ),
@@ -262,26 +266,41 @@ def _number_list(value, where: str, source: str) -> list[float]:
     if (
         not isinstance(value, list)
         or not value
+        or len(value) > MAX_DIRECTIONS
         or not all(
             isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
             for v in value
         )
     ):
-        raise ConfigError(f"{source}: {where} must be a non-empty list of numbers")
+        raise ConfigError(f"{source}: {where} must be a list of 1 to {MAX_DIRECTIONS} numbers")
     return [float(v) for v in value]
 
 
-def _positive(value, where: str, source: str, allow_zero: bool = False) -> float:
+def _positive(
+    value, where: str, source: str, allow_zero: bool = False, maximum: float = math.inf
+) -> float:
     if (
         isinstance(value, bool)
         or not isinstance(value, (int, float))
         or not math.isfinite(value)
         or value < 0
         or (value == 0 and not allow_zero)
+        or value > maximum
     ):
         bound = ">= 0" if allow_zero else "> 0"
+        if maximum < math.inf:
+            bound += f" and <= {maximum:g}"
         raise ConfigError(f"{source}: {where} must be a number {bound}, got {value!r}")
     return float(value)
+
+
+# Bounds on a layout (docs/design.md section 5): far beyond any robot's sensors, and small
+# enough that the simulated sensors' lookup tables (sized by the range) and the rays cast
+# each cycle fit the machine. A 300 m range asked for 1.4 GiB at once.
+#: The longest rangefinder range (m): beyond the largest maze.
+MAX_RANGE = 50.0
+#: Rays per rangefinder, and rangefinders or goal sectors per layout.
+MAX_RAYS, MAX_DIRECTIONS = 100, 360
 
 
 def range_reading(distance: float, max_range: float) -> float:
