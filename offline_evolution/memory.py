@@ -64,6 +64,38 @@ def check_memory(need: float, what: str, advice: str) -> None:
         )
 
 
+#: The shipped value of each setting that multiplies a generation's or a post-evaluation's
+#: episodes; the one furthest above its own is named as the cause of an excess.
+USUAL = {
+    "[NEAT] pop_size": 150,
+    "samples_per_maze": 1,
+    "training.generated": 10,
+    "training.starts": 1,
+    "hall_of_fame": 25,  # the post-evaluation's genomes / 3
+    "post_samples": 10,
+}
+
+
+def _first_cause(values: dict[str, tuple[str, int]]) -> tuple[str, str, int]:
+    """``(source, key, value)`` of the setting furthest above its :data:`USUAL` value.
+
+    Args:
+        values: key -> (where it is set, its value).
+    """
+    key = max(values, key=lambda k: values[k][1] / USUAL[k])
+    return values[key][0], key, values[key][1]
+
+
+def _lower(cause: str, keys: list[str]) -> str:
+    """``lower CAUSE, A or B``: what to lower, the cause first."""
+    rest = [k for k in keys if k != cause]
+    return (
+        f"lower {cause}"
+        + (f", {', '.join(rest[:-1])}" if len(rest) > 1 else "")
+        + (f" or {rest[-1]}" if rest else "")
+    )
+
+
 def check_evolution_memory(
     task,
     pop_size: int,
@@ -73,8 +105,13 @@ def check_evolution_memory(
     post_samples: int,
     finalists: int = 0,
     final_samples: int = 0,
+    neat_source: str = "the NEAT settings",
+    run_source: str = "the run settings",
 ) -> None:
     """Refuse an evolution whose generation (or post-evaluation) cannot fit in memory.
+
+    The message starts with the setting furthest above its shipped value (:data:`USUAL`),
+    where it is set, and says what to lower, that setting first.
 
     Args:
         task: the :class:`~offline_evolution.maze_task.task.MazeTaskSettings`.
@@ -85,6 +122,7 @@ def check_evolution_memory(
         post_samples: its draws of samples_per_maze random starts per maze (plus the
             nominal one).
         finalists, final_samples: its second round (``post_finalists``), if any.
+        neat_source, run_source: the NEAT and run settings' files, for the message.
     """
     mazes = len(task.mazes)
     per_episode = lookup(robot).episode_bytes
@@ -99,19 +137,39 @@ def check_evolution_memory(
     per_maze = post_samples * task.samples_per_maze + 1
     post = post_candidates * (mazes * per_maze + post_extra)
     where = f"{mazes} mazes x {task.samples_per_maze} starts"
+    causes = {
+        "[NEAT] pop_size": (neat_source, pop_size),
+        "samples_per_maze": (source, task.samples_per_maze),
+    }
     if training is not None:
         where = f"({where} + {training.generated} generated mazes x {training.starts})"
+        causes["training.generated"] = (source, training.generated)
+        causes["training.starts"] = (source, training.starts)
+    file, key, value = _first_cause(causes)
+    names = [k.replace("[NEAT] ", "") for k in causes]
     check_memory(
         BASE_BYTES + per_episode * generation,
-        f"{source}: samples_per_maze {task.samples_per_maze} ({generation:,} episodes a "
+        f"{file}: {key} {value} ({generation:,} episodes a "
         f"generation: {pop_size} genomes x {where})",
-        "lower samples_per_maze, the number of mazes or pop_size",
+        _lower(
+            key.replace("[NEAT] ", ""),
+            ["samples_per_maze", "the number of mazes", "pop_size", *names[2:]],
+        ),
     )
+    file, key, value = _first_cause(
+        {
+            "post_samples": (run_source, post_samples),
+            "samples_per_maze": (source, task.samples_per_maze),
+            "hall_of_fame": (run_source, post_candidates // 3),  # 3 x hall_of_fame + snapshots
+        }
+    )
+    cause = f"{key} {value}" if key != "hall_of_fame" else "hall_of_fame and snapshot_every"
     check_memory(
         BASE_BYTES + per_episode * post,
-        f"the post-evaluation ({post:,} episodes: {post_candidates} genomes x {mazes} mazes "
-        f"x {per_maze} starts" + (f" + {post_extra} in validation mazes)" if post_extra else ")"),
-        "lower post_samples or hall_of_fame",
+        f"{file}: {cause}: the post-evaluation ({post:,} episodes: {post_candidates} "
+        f"genomes x {mazes} mazes x {per_maze} starts"
+        + (f" + {post_extra} in validation mazes)" if post_extra else ")"),
+        _lower(key, ["post_samples", "hall_of_fame", "samples_per_maze"]),
     )
     if finalists and final_samples:  # the second round's starts have no nominal rows
         final_extra = training.post_mazes * final_samples if training is not None else 0

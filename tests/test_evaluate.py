@@ -187,7 +187,7 @@ def test_an_empty_maze_folder_and_one_file_for_two_outputs_are_refused(tmp_path,
     assert "holds no .yaml maze files" in capsys.readouterr().err
     both = str(tmp_path / "r.png")
     assert main(["evaluate", "--plot", both, "--out", both]) == 1
-    assert "--plot and --out name the same file" in capsys.readouterr().err
+    assert f"--out {both} is the same file as --plot" in capsys.readouterr().err
 
 
 def test_reach_interval_is_wilsons():

@@ -49,7 +49,7 @@ def test_a_reduced_protocol_is_an_override_recorded_in_every_run():
 @pytest.mark.parametrize(
     ("change", "message"),
     [
-        ({"seeds": 0}, "seeds must be an integer >= 1"),
+        ({"seeds": 0}, "seeds must be an integer from 1 to 1,000"),
         ({"grid": {"robot": ["4ws-9"]}}, "grid.robot: '4ws-9' is not one of"),
         ({"grid": {"bin_size": [-0.04]}}, "grid.bin_size: expected a positive number"),
         ({"fixed": {"speed": 3}}, "fixed.speed: unknown setting key"),

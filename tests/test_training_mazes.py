@@ -346,7 +346,7 @@ def test_generated_episodes_count_in_the_memory_check(monkeypatch):
         memory.check_evolution_memory(settings, 150, "4ws-5", "t.yaml", 75, 10)
     message = str(info.value)
     assert "150 genomes x (2 mazes x 1 starts + 20 generated mazes x 50000)" in message
-    assert message.startswith("t.yaml: samples_per_maze 1 (150,000,300 episodes a generation")
+    assert message.startswith("t.yaml: training.starts 50000 (150,000,300 episodes a generation")
 
 
 @pytest.mark.parametrize("name", ["maze-4ws-generated.yaml", "maze-hexapod-generated.yaml"])

@@ -10,13 +10,20 @@ flushed to disk, and then renamed over the destination.
   never touched.
 * A failed write (disk full, quota, file too large) raises :class:`OSError` naming the
   destination, not the hidden temporary: ``r.json: No space left on device``.
+* The destination is a regular file or nothing. A symbolic link is written through: its
+  target is replaced and the link kept (``ln -s`` to a shared results folder works as
+  users expect). Anything else that exists there (a device, a named pipe, a socket, a
+  folder) is refused: renaming over ``/dev/null`` as root would replace the system's
+  device with a regular file (docs/design.md section 12, "Writing").
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import socket
+import stat
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -33,17 +40,57 @@ def _prefix(dest: Path) -> str:
     return f".{dest.name}.tmp-"
 
 
+#: What a path that is not a regular file is, by its ``stat`` type, as a message says it.
+_KINDS = (
+    (stat.S_ISDIR, "a folder"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISFIFO, "a named pipe (FIFO)"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def special_file_kind(path: str | os.PathLike) -> str | None:
+    """What ``path`` (links followed) is if it exists and is not a regular file, else None.
+
+    ``"a character device"`` for ``/dev/null``, ``"a folder"``, ``"a named pipe (FIFO)"``...
+    """
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return None  # missing (or a dangling link, written through): a new file
+    if stat.S_ISREG(mode):
+        return None
+    return next((kind for test, kind in _KINDS if test(mode)), "not a regular file")
+
+
+def write_target(path: str | os.PathLike) -> Path:
+    """The file a write of ``path`` replaces: ``path`` with every symbolic link resolved.
+
+    Raises:
+        OSError: ``path`` is something other than a regular file (see module doc).
+    """
+    kind = special_file_kind(path)
+    if kind:
+        code = errno.EISDIR if kind == "a folder" else errno.EEXIST
+        raise OSError(code, f"is {kind}, not a regular file; refusing to replace it", str(path))
+    return Path(os.path.realpath(path))
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path next to ``path``; on success it is renamed onto ``path``.
 
     For writers that insist on a file name (matplotlib, numpy). The temporary keeps the
-    destination's suffix so that format detection by extension still works.
+    destination's suffix so that format detection by extension still works. A link is
+    written through to its target (see module doc).
 
     Raises:
-        OSError: from the system, with ``filename`` the destination (see module doc).
+        OSError: from the system, with ``filename`` the destination (see module doc); or
+            ``path`` exists and is not a regular file.
     """
-    dest = Path(path)
+    given = Path(path)
+    dest = write_target(given)
     try:
         dest.parent.mkdir(parents=True, exist_ok=True)
         remove_stale_temporaries(dest)
@@ -54,7 +101,7 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
         )
         os.close(fd)
     except OSError as e:
-        raise _naming(e, dest) from None
+        raise _naming(e, given) from None
     tmp_path = Path(tmp)
     try:
         # mkstemp creates 0600 files; give the result the permissions a plain open() would.
@@ -62,9 +109,10 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
         yield tmp_path
         with open(tmp_path, "rb+") as f:
             os.fsync(f.fileno())
+        write_target(given)  # again: it may have been replaced while the writer ran
         os.replace(tmp_path, dest)
     except OSError as e:
-        raise _naming(e, dest) from None
+        raise _naming(e, given) from None
     finally:
         tmp_path.unlink(missing_ok=True)
 

@@ -11,9 +11,10 @@ import tempfile
 
 import neat
 
-from evorbc_ros.config import INT_LIMIT, ConfigError
+from evorbc_ros.config import ConfigError
 from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular_text
 from evorbc_ros.network import ACTIVATIONS, AGGREGATIONS
+from offline_evolution import bounds
 from offline_evolution.arbitrator.neat_classes import (
     EvoRBCGenome,
     EvoRBCReproduction,
@@ -105,8 +106,11 @@ def _check_neat_section(config: neat.Config, parser: configparser.ConfigParser, 
     Raises:
         ConfigError: ``FILE: [NEAT] key ...`` in one line.
     """
-    if config.pop_size > INT_LIMIT:
-        raise ConfigError(f"{source}: [NEAT] pop_size must be at most {INT_LIMIT:,}")
+    if config.pop_size > bounds.POP_SIZE:  # docs/design.md section 12
+        raise ConfigError(
+            f"{source}: [NEAT] pop_size must be at most {bounds.POP_SIZE:,}, got "
+            f"{config.pop_size:,}; lower it"
+        )
     criterion = parser["NEAT"].get("fitness_criterion", "max").strip()
     if criterion not in FITNESS_CRITERIA:
         raise ConfigError(
@@ -216,3 +220,11 @@ def _check_values(config: neat.Config, parser: configparser.ConfigParser, source
     for ok, what, value in checks:
         if not ok:
             raise ConfigError(f"{source}: {what}, got {value}")
+    # Every new genome starts with them: neat-python takes minutes to create a population
+    # with thousands (docs/design.md section 12).
+    hidden = config.genome_config.num_hidden
+    if hidden > bounds.NUM_HIDDEN:
+        raise ConfigError(
+            f"{source}: [{GENOME_SECTION}] num_hidden must be at most {bounds.NUM_HIDDEN}, got "
+            f"{hidden}; lower it (NEAT adds hidden nodes as it needs them)"
+        )

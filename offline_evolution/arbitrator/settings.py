@@ -10,6 +10,7 @@ from pathlib import Path
 from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
 from evorbc_ros.mapping import MAPPINGS
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, lookup
+from offline_evolution import bounds
 from offline_evolution.arbitrator.selection import RULES
 
 
@@ -17,7 +18,7 @@ from offline_evolution.arbitrator.selection import RULES
 class ArbitratorRunSettings:
     """Defaults of ``evorbc-evolve arbitrator`` and ``standard`` for a robot."""
 
-    generations: int = setting(doc="NEAT generations", minimum=1)
+    generations: int = setting(doc="NEAT generations", minimum=1, maximum=bounds.GENERATIONS)
     mapping: str = setting("polar", doc="mapping function", choices=MAPPINGS)
     neat: str = setting("neat/4ws.ini", doc="NEAT settings file, relative to config/")
     task: str = setting("tasks/maze-4ws.yaml", doc="task settings file, relative to config/")

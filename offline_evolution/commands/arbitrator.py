@@ -10,12 +10,15 @@ from pathlib import Path
 
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.registry import ROBOT_NAMES, lookup
+from offline_evolution import bounds
 from offline_evolution.commands.common import (
     CliError,
     EpisodeProgress,
     add_workers_option,
     at_least,
     check_distinct,
+    check_outputs,
+    checkpoint_option,
     count,
     default_checkpoint,
     exclusive_outputs,
@@ -23,13 +26,13 @@ from offline_evolution.commands.common import (
     running,
     write_then_discard,
 )
-from sim_bridge.cli_support import check_output_file
+from sim_bridge.cli_support import check_output_file, integer_in
 
 
 def _common_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--generations",
-        type=at_least(1),
+        type=integer_in(1, bounds.GENERATIONS),
         metavar="N",
         help="NEAT generations (default: the robot's run settings, Table I)",
     )
@@ -52,7 +55,10 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         "from it automatically",
     )
     p.add_argument(
-        "--checkpoint-every", type=count, metavar="N", help="generations between checkpoints"
+        "--checkpoint-every",
+        type=at_least(1),
+        metavar="N",
+        help="generations between checkpoints",
     )
     p.add_argument(
         "--restart",
@@ -200,12 +206,17 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     from offline_evolution.memory import check_evolution_memory
     from sim_bridge.maze import load_named_maze
 
-    out = Path(args.out)
-    plot = Path(args.plot) if args.plot else out.with_name(out.stem + ".fitness.png")
-    checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.json")
     # Every output is checked before any work, so that a typo costs nothing.
-    check_output_file(str(out), "--out")
-    check_output_file(str(plot), "--plot" if args.plot else "the default --plot", picture=True)
+    check_output_file(args.out, "--out")
+    out = Path(args.out)
+    plot = Path(args.plot) if args.plot is not None else out.with_name(out.stem + ".fitness.png")
+    checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.json")
+    written = {
+        "--out": out,
+        "--plot" if args.plot is not None else "the default --plot": plot,
+        checkpoint_option(args.checkpoint): checkpoint,
+    }
+    check_outputs(written)
     repertoire = None
     if args.kind == "evorbc":
         repertoire = Repertoire.load(args.repertoire)
@@ -253,9 +264,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     )
     check_distinct(
         {
-            "--out": out,
-            "--plot": plot,
-            "--checkpoint": checkpoint,
+            **written,
             "--repertoire": args.repertoire if repertoire else None,
             "--config": args.config,
             "--neat-config": args.neat_config,
@@ -273,9 +282,11 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         run.post_samples,
         run.post_finalists,
         run.post_final_samples,
+        neat_source=str(neat_file),
+        run_source=str(args.config or lookup(robot).settings_file("arbitrator")),
     )
     every = args.checkpoint_every or run.checkpoint_every
-    with exclusive_outputs({"--out": out, "--checkpoint": args.checkpoint}):
+    with exclusive_outputs(written):
         result = _run(args, settings, every, repertoire, checkpoint, initial_network)
 
         def write() -> None:

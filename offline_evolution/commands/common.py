@@ -13,6 +13,7 @@ import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+from offline_evolution import bounds
 from sim_bridge.cli_support import integer_in
 
 EXIT_ERROR = 1
@@ -160,7 +161,7 @@ def add_workers_option(parser: argparse.ArgumentParser) -> None:
     """``--workers N``: processes for PyBullet simulations (results do not depend on it)."""
     parser.add_argument(
         "--workers",
-        type=count,
+        type=integer_in(1, bounds.WORKERS),
         metavar="N",
         help="worker processes for robots simulated in PyBullet (default: one per core; "
         "with --cluster, one per cluster CPU); results are the same for any number",
@@ -175,7 +176,25 @@ def add_workers_option(parser: argparse.ArgumentParser) -> None:
 
 def default_checkpoint(out: Path, given: str | None, suffix: str) -> Path:
     """The checkpoint path: ``given``, or ``OUT<suffix>`` next to the output."""
-    return Path(given) if given else out.with_name(out.name + suffix)
+    return Path(given) if given is not None else out.with_name(out.name + suffix)
+
+
+def checkpoint_option(given: str | None) -> str:
+    """How messages name the checkpoint: ``--checkpoint``, or the default one."""
+    return "--checkpoint" if given is not None else "the default --checkpoint"
+
+
+def check_outputs(files: dict[str, str | os.PathLike | None]) -> None:
+    """Refuse, before any work, an output of ``files`` (option -> path) that cannot be one.
+
+    A ``.png``-like option (``--plot``, ``--heatmap``) must also name a picture format.
+    See :func:`sim_bridge.cli_support.check_output_file`.
+    """
+    from sim_bridge.cli_support import check_output_file
+
+    for option, path in files.items():
+        if path is not None:
+            check_output_file(str(path), option, picture=option.endswith(("--plot", "--heatmap")))
 
 
 def _identity(path: str | os.PathLike):
@@ -247,11 +266,15 @@ def lock_file(path: str | os.PathLike) -> Path:
 def exclusive_outputs(files: dict[str, str | os.PathLike | None]) -> Iterator[None]:
     """Hold an OS lock on each of ``files`` (option -> path; None skipped) for a run.
 
-    Two runs given the same ``--out`` would share one checkpoint, and the last to write
-    would win; the second is refused while the first runs. The lock (``flock`` on
-    :func:`lock_file`) belongs to the process, so the system releases it when the process
-    ends in any way, SIGKILL included: a killed run never blocks the next one. The lock
-    file is removed when the run ends normally.
+    Two runs writing one file would share its checkpoint, or overwrite each other's
+    output, and the last to write would win; the second is refused while the first runs.
+    Every file a run writes is locked (its output, checkpoint, CSV and pictures), under
+    its resolved name (``os.path.realpath``), so that the same file reached through a
+    symbolic link, a relative path or another option (one run's ``--csv`` given as
+    another's ``--out``) is one lock. The lock (``flock`` on :func:`lock_file`) belongs
+    to the process, so the system releases it when the process ends in any way, SIGKILL
+    included: a killed run never blocks the next one. The lock file is removed when the
+    run ends normally.
 
     Raises:
         CliError: naming the option, the file and the running process.
@@ -265,12 +288,15 @@ def exclusive_outputs(files: dict[str, str | os.PathLike | None]) -> Iterator[No
 
 @contextlib.contextmanager
 def _locked(path: Path, option: str) -> Iterator[None]:
-    lock = lock_file(path)
+    real = Path(os.path.realpath(path))
+    lock = lock_file(real)
+    # The file's own name, when the option reached it through a link or another folder.
+    name = path if real == Path(os.path.abspath(path)) else f"{path} (the file {real})"
     try:
         lock.parent.mkdir(parents=True, exist_ok=True)
-        fd = _acquire(lock, path, option)
+        fd = _acquire(lock, name, option)
     except OSError as e:
-        raise CliError(f"{option} {path}: cannot lock {lock} ({e.strerror})") from None
+        raise CliError(f"{option} {name}: cannot lock {lock} ({e.strerror})") from None
     try:
         yield
     finally:
@@ -281,7 +307,7 @@ def _locked(path: Path, option: str) -> Iterator[None]:
         os.close(fd)
 
 
-def _acquire(lock: Path, path: Path, option: str, tries: int = 20) -> int:
+def _acquire(lock: Path, path: Path | str, option: str, tries: int = 20) -> int:
     """An open, locked descriptor of ``lock`` that is still the file at that path."""
     for _ in range(tries):
         fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)

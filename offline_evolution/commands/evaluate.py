@@ -19,10 +19,19 @@ from evorbc_ros.defaults import (
     ships_controller,
 )
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
-from offline_evolution.commands.common import CliError, EpisodeProgress, at_least, count
+from offline_evolution import bounds
+from offline_evolution.commands.common import (
+    CliError,
+    EpisodeProgress,
+    at_least,
+    check_distinct,
+    check_outputs,
+    count,
+    exclusive_outputs,
+)
 from offline_evolution.commands.replay import check_task, controller_inputs
 from offline_evolution.mazes.held_out import HELD_OUT_SEED  # never trained on
-from sim_bridge.cli_support import check_output_file
+from sim_bridge.cli_support import integer_in
 
 #: The suite word for the mazes the controller was trained on (its task's mazes).
 PAPER = "paper"
@@ -66,9 +75,10 @@ def add_parsers(sub) -> None:
     )
     p.add_argument(
         "--generated",
-        type=at_least(1),
+        type=integer_in(1, bounds.MAZES),
         metavar="N",
-        help="add N mazes generated for the robot (evorbc-evolve mazes) to the suite",
+        help="add N mazes generated for the robot (evorbc-evolve mazes) to the suite "
+        f"(at most {bounds.MAZES:,})",
     )
     p.add_argument(
         "--generated-seed",
@@ -129,6 +139,15 @@ def load_arbitrator(args) -> tuple[ArbitratorFile, Path]:
 
 def cmd_evaluate(args: argparse.Namespace) -> int:
     """Evaluate, print the report, draw the suite."""
+    written = {"--plot": args.plot, "--out": args.out}
+    check_outputs(written)
+    check_distinct(written)
+    with exclusive_outputs(written):
+        return _evaluate(args)
+
+
+def _evaluate(args: argparse.Namespace) -> int:
+    """:func:`cmd_evaluate` once its outputs are checked and locked."""
     from offline_evolution.maze_task.base import MazeTaskSettings
     from offline_evolution.maze_task.evaluation import evaluate_suite
     from offline_evolution.maze_task.perturbation import load_perturbations
@@ -136,26 +155,22 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     from offline_evolution.memory import check_replay_memory
     from sim_bridge.robots.base import control_steps
 
-    if args.plot and args.out and Path(args.plot).resolve() == Path(args.out).resolve():
-        raise CliError(f"--plot and --out name the same file {args.out}")
-    for path, option, picture in ((args.plot, "--plot", True), (args.out, "--out", False)):
-        if path:
-            check_output_file(path, option, picture=picture)
     perturbation = load_perturbations(args.perturb)
     arb, arb_path = load_arbitrator(args)
     repertoire, rep_path, base = controller_inputs(arb, arb_path, args)
     with tempfile.TemporaryDirectory(prefix="evorbc-suite-") as tmp:
         names = suite_mazes(args.mazes, base.mazes, bool(args.generated))
+        # Checked before the mazes are generated, which takes about 0.1 s each.
+        check_replay_memory(
+            (len(names) + (args.generated or 0)) * args.starts,
+            control_steps(base.episode_time, CONTROL_PERIOD),
+            len(arb.network.output_keys),
+            arb.robot,
+            f"episode_time {base.episode_time} s; --starts {args.starts}",
+        )
         if args.generated:
             names += _generated_files(arb.robot, args.generated, args.generated_seed, Path(tmp))
         settings = MazeTaskSettings(tuple(names), base.episode_time, 1, base.sensors)
-        check_replay_memory(
-            len(names) * args.starts,
-            control_steps(settings.episode_time, CONTROL_PERIOD),
-            len(arb.network.output_keys),
-            arb.robot,
-            f"episode_time {settings.episode_time} s",
-        )
         try:
             task = make_task(settings, arb.robot)
         except ConfigError as e:

@@ -8,8 +8,9 @@ import math
 from pathlib import Path
 
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
-from offline_evolution.commands.common import CliError, at_least, count
-from sim_bridge.cli_support import check_output_file
+from offline_evolution import bounds
+from offline_evolution.commands.common import CliError, count
+from sim_bridge.cli_support import check_output_file, integer_in
 
 
 def add_parsers(sub) -> None:
@@ -23,7 +24,13 @@ def add_parsers(sub) -> None:
         "clearance-aware path search and written as an ordinary maze file.",
     )
     p.add_argument("--robot", choices=ROBOT_NAMES, default=DEFAULT_ROBOT, help="robot type")
-    p.add_argument("--count", type=at_least(1), default=10, metavar="N", help="mazes (10)")
+    p.add_argument(
+        "--count",
+        type=integer_in(1, bounds.MAZES),
+        default=10,
+        metavar="N",
+        help=f"mazes (10; at most {bounds.MAZES:,})",
+    )
     p.add_argument("--seed", type=count, default=0, metavar="N", help="seed (0)")
     p.add_argument(
         "--serpentine",
@@ -61,6 +68,8 @@ def share(text: str) -> float:
 
 def out_folder(path: str, option: str) -> Path:
     """``path`` as a writable folder (created if missing), or a one-line error."""
+    if not path:
+        raise CliError(f"{option} '': an empty name, expected a folder")
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise CliError(f"{option} {path}: is a file, expected a folder")
@@ -79,8 +88,10 @@ def cmd_mazes(args: argparse.Namespace) -> int:
     from offline_evolution.plots.suite import plot_suite
 
     folder = out_folder(args.out, "--out")
-    picture = None if args.plot == "none" else (args.plot or str(folder / "mazes.png"))
-    if picture:
+    picture = None if args.plot == "none" else args.plot
+    if picture is None and args.plot is None:
+        picture = str(folder / "mazes.png")
+    if picture is not None:
         check_output_file(picture, "--plot", picture=True)
     spec = spec_for_robot(args.robot)
     prefix = "gen"

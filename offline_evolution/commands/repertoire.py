@@ -12,7 +12,10 @@ from evorbc_ros.robots.registry import ROBOT_NAMES, lookup
 from offline_evolution.commands.common import (
     CliError,
     add_workers_option,
+    at_least,
     check_distinct,
+    check_outputs,
+    checkpoint_option,
     count,
     default_checkpoint,
     exclusive_outputs,
@@ -77,7 +80,7 @@ def add_parsers(sub) -> None:
     )
     rep.add_argument(
         "--checkpoint-every",
-        type=count,
+        type=at_least(1),
         default=100,
         metavar="N",
         help="iterations between checkpoints (default: 100)",
@@ -170,34 +173,31 @@ OPTIONS = {
 def cmd_repertoire(args: argparse.Namespace) -> int:
     """Generate a repertoire, write it (and optionally a plot and CSV), print a summary."""
     from offline_evolution.memory import check_repertoire_memory
-    from offline_evolution.repertoire.settings import load_settings, settings_path
+    from offline_evolution.repertoire.settings import check_budget, load_settings, settings_path
 
+    # Every output is checked before any work, so that a typo costs nothing.
+    check_output_file(args.out, "--out")
     out = Path(args.out)
     checkpoint = default_checkpoint(out, args.checkpoint, ".checkpoint.npz")
-    check_distinct(
-        {
-            "--out": out,
-            "--plot": args.plot,
-            "--csv": args.csv,
-            "--checkpoint": checkpoint,
-            "--config": args.config,
-        }
-    )
-    # Every output is checked before any work, so that a typo costs nothing.
-    check_output_file(str(out), "--out")
-    if args.plot:
-        check_output_file(args.plot, "--plot", picture=True)
-    if args.csv:
-        check_output_file(args.csv, "--csv")
+    written = {
+        "--out": out,
+        "--plot": args.plot,
+        "--csv": args.csv,
+        checkpoint_option(args.checkpoint): checkpoint,
+    }
+    check_distinct({**written, "--config": args.config})
+    check_outputs(written)
     given = {key: option for key, option in OPTIONS.items() if getattr(args, key) is not None}
     config = settings_path(args.config, args.robot)
     settings = load_settings(config, options=given, **{k: getattr(args, k) for k in OPTIONS})
+
     check_repertoire_memory(
         settings,
         lookup(settings.robot).n_parameters,
         lambda key: given.get(key) or f"{config}: {key}",
     )
-    with exclusive_outputs({"--out": out, "--checkpoint": args.checkpoint}):
+    check_budget(settings, config, given)
+    with exclusive_outputs(written):
         repertoire, elapsed = _run(args, settings, config, given, checkpoint)
         write_then_discard(checkpoint, lambda: _write(repertoire, out, args.plot, args.csv))
     s = repertoire.summary()
@@ -258,10 +258,12 @@ def _write(repertoire: Repertoire, out: Path, plot: str | None, csv: str | None)
 def cmd_export_csv(args: argparse.Namespace) -> int:
     """Convert a repertoire file to CSV."""
     repertoire = Repertoire.load(args.repertoire)
-    out = Path(args.out) if args.out else Path(args.repertoire).with_suffix(".csv")
-    out_option = "--out" if args.out else "the default --out"
+    if args.out is not None:
+        out_option, out = "--out", args.out
+    else:
+        out_option, out = "the default --out", str(Path(args.repertoire).with_suffix(".csv"))
+    check_output_file(out, out_option)
     check_distinct({"REPERTOIRE": args.repertoire, out_option: out})
-    check_output_file(str(out), out_option)
     repertoire.to_csv(out)
     print(f"{len(repertoire)} primitives -> {out}")
     return 0

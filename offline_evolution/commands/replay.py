@@ -13,8 +13,14 @@ from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.defaults import default_repertoire
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.registry import lookup
-from offline_evolution.commands.common import CliError, EpisodeProgress, at_least, count
-from sim_bridge.cli_support import check_output_file
+from offline_evolution.commands.common import (
+    CliError,
+    EpisodeProgress,
+    at_least,
+    check_distinct,
+    check_outputs,
+    count,
+)
 from sim_bridge.robots.design import check_simulation, simulation_mismatch
 
 #: How a user lets another repertoire fingerprint or sensor layout through.
@@ -174,9 +180,9 @@ def cmd_replay(args: argparse.Namespace) -> int:
     arb_path = Path(args.arbitrator)
     if args.episodes > 1 and args.start != "random":
         raise CliError("--episodes N needs N >= 1, and N > 1 needs --start random")
-    for path, option in ((args.plot, "--plot"), (args.heatmap, "--heatmap")):
-        if path:
-            check_output_file(path, option, picture=True)
+    written = {"--plot": args.plot, "--heatmap": args.heatmap}
+    check_outputs(written)
+    check_distinct(written)
     arb = ArbitratorFile.load(arb_path)
     if args.heatmap and arb.kind != "evorbc":
         raise CliError("--heatmap needs an EvoRBC arbitrator (standard NEAT has no primitives)")

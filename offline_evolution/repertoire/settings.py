@@ -21,6 +21,7 @@ from evorbc_ros.config import (
     setting,
 )
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES, lookup
+from offline_evolution import bounds
 from offline_evolution.quality import METRICS
 
 ARCHIVES = ("grid", "cvt")
@@ -35,9 +36,14 @@ class MapElitesSettings:
     metric: str = setting(doc="quality metric", choices=tuple(METRICS))
     bin_size: float = setting(doc="side of a square archive cell (m)", minimum=1e-4)
     eval_time: float = setting(doc="primitive evaluation time T (s)", minimum=0.1)
-    initial_batch: int = setting(doc="random solutions in the first batch (S_G)", minimum=1)
+    initial_batch: int = setting(
+        doc="random solutions in the first batch (S_G)", minimum=1, maximum=bounds.INITIAL_BATCH
+    )
+    # Bounded by memory (offline_evolution/memory.py) and by bounds.EVALUATIONS.
     batch_size: int = setting(doc="mutants per iteration (S_B)", minimum=1)
-    iterations: int = setting(doc="iterations after the initial batch (I)", minimum=0)
+    iterations: int = setting(
+        doc="iterations after the initial batch (I)", minimum=0, maximum=bounds.ITERATIONS
+    )
     mutation_probability: float = setting(
         0.25, doc="per-gene mutation probability", minimum=0.0, maximum=1.0
     )
@@ -127,6 +133,28 @@ def load_settings(
     values = load_yaml_mapping(path)
     values.update(overrides)
     return build_settings(MapElitesSettings, values, str(path))
+
+
+def check_budget(
+    settings: MapElitesSettings, path: str | os.PathLike, options: Mapping[str, str]
+) -> None:
+    """Refuse a run of more than :data:`~offline_evolution.bounds.EVALUATIONS` evaluations.
+
+    Args:
+        path: the settings file the run read.
+        options: setting key -> the command-line option that set it (only those given).
+
+    Raises:
+        ConfigError: one line with the count, the bound and the settings to lower.
+    """
+    if settings.evaluations > bounds.EVALUATIONS:
+        keys = ("iterations", "batch_size", "initial_batch")
+        names = [options.get(k) or f"{k} in {path}" for k in keys]
+        raise ConfigError(
+            f"initial_batch + iterations x batch_size = {settings.evaluations:,} evaluations, "
+            f"more than the bound of {bounds.EVALUATIONS:,} a run (docs/design.md section "
+            f"12); lower {', '.join(names[:-1])} or {names[-1]}"
+        )
 
 
 def _check_override(key: str, value, label: str) -> None:

@@ -22,6 +22,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from evorbc_ros.config import ConfigError
+from offline_evolution import bounds
 from sim_bridge.cli_support import OneLineParser, integer_in, report_unexpected
 
 EXIT_ERROR = 1
@@ -58,14 +59,15 @@ def build_parser() -> argparse.ArgumentParser:
         if name == "run":
             s.add_argument(
                 "--jobs",
-                type=integer_in(1),
+                type=integer_in(1, bounds.WORKERS),
                 help="runs at once on this machine (default: one per core)",
             )
             s.add_argument(
                 "--threads",
-                type=integer_in(1),
+                type=integer_in(1, bounds.THREADS),
                 default=1,
-                help="numba threads per run (default 1; results do not depend on it)",
+                help="numba threads per run (default 1, at most "
+                f"{bounds.THREADS}; results do not depend on it)",
             )
             s.add_argument(
                 "--address",
@@ -74,14 +76,14 @@ def build_parser() -> argparse.ArgumentParser:
             )
             s.add_argument(
                 "--spread",
-                type=integer_in(1),
+                type=integer_in(1, bounds.WORKERS),
                 metavar="N",
                 help="Ray: N runs at once, each spreading its PyBullet simulations over the "
                 "whole cluster (for legged robots, whose runs are hours on one machine)",
             )
             s.add_argument(
                 "--retries",
-                type=int,
+                type=integer_in(0, bounds.RETRIES),
                 default=3,
                 help="Ray: times a run lost with its node is retried from its checkpoint (3)",
             )
@@ -112,12 +114,12 @@ def _study_options(p: argparse.ArgumentParser, protocol: bool = True) -> None:
         return
     p.add_argument(
         "--seeds",
-        type=integer_in(1),
+        type=integer_in(1, bounds.SEEDS),
         help="reduced protocol: seeds 1..N per setting (default: the study file's)",
     )
     p.add_argument(
         "--generations",
-        type=integer_in(1),
+        type=integer_in(1, bounds.GENERATIONS),
         help="reduced protocol: NEAT generations of every run (default: the study file's)",
     )
     p.add_argument(
@@ -164,7 +166,7 @@ def cmd_status(args) -> int:
     from offline_evolution.study.run import check_settings, is_finished
 
     study, runs = _selected_runs(args)
-    results = Path(args.results)
+    results = results_folder(args.results)
     done = started = 0
     for run in runs:
         folder = results / run.path
@@ -178,6 +180,18 @@ def cmd_status(args) -> int:
         f"{len(runs) - done - started} not started, of {len(runs)} runs in {results}"
     )
     return 0
+
+
+def results_folder(path: str) -> Path:
+    """``--results``, refused in one line if it is empty or exists and is not a folder."""
+    from evorbc_ros.atomic_io import special_file_kind
+
+    if not path:
+        raise StudyError("--results '': an empty name, expected a folder")
+    kind = special_file_kind(path) or ("a file" if Path(path).is_file() else None)
+    if kind and kind != "a folder":
+        raise StudyError(f"--results {path}: is {kind}, expected a folder")
+    return Path(path)
 
 
 class ResultsLock:
@@ -213,7 +227,7 @@ def cmd_run(args) -> int:
     from offline_evolution.study.run import RunRecord, check_settings, is_finished
 
     study, runs = _selected_runs(args)
-    results = Path(args.results)
+    results = results_folder(args.results)
     if args.spread and not args.address:
         raise StudyError("--spread needs a Ray cluster (--address or RAY_ADDRESS)")
     jobs = args.jobs or max(1, (os.cpu_count() or 1) // args.threads)

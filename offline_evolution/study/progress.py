@@ -19,11 +19,11 @@ class StudyProgress:
     shown (a guess from the first, compile-heavy minutes would be wild).
     """
 
-    def __init__(self, name: str, runs: list[Run], parallel: int, stream=sys.stderr):
+    def __init__(self, name: str, runs: list[Run], parallel: int, stream=None):
         self.name = name
         self.runs = {r.path: r for r in runs}
         self.parallel = max(1, parallel)
-        self.stream = stream
+        self.stream = stream or sys.stderr  # the one in force now (a test may replace it)
         self.done: set = set()
         self.running: set = set()
         self.failed: set = set()

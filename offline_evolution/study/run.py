@@ -35,7 +35,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from evorbc_ros.atomic_io import atomic_write
+from evorbc_ros.atomic_io import atomic_write, special_file_kind
 from offline_evolution.study.spec import Run
 from sim_bridge.cluster_pool import CLUSTER_VARIABLE
 
@@ -139,6 +139,36 @@ def commands(run: Run, folder: Path, workers: int | None = None) -> list[list[st
     return out
 
 
+#: Every file a run writes in its folder (the commands' outputs, checkpoints and log).
+RUN_FILES = (
+    "run.log",
+    "repertoire.json",
+    "repertoire.json.xz",
+    "repertoire.json.checkpoint.npz",
+    "arbitrator.json",
+    "arbitrator.json.xz",
+    "arbitrator.json.checkpoint.json",
+    "fitness-curve.png",
+)
+
+
+def check_run_files(folder: Path) -> None:
+    """Refuse a run folder where a file the run writes is a device, a pipe or a folder.
+
+    Checked before the run starts (a named pipe as ``run.log`` would block it for good;
+    a device would be replaced by the first write: docs/design.md section 12).
+
+    Raises:
+        RunError: naming the file and what it is.
+    """
+    for name in (*RUN_FILES, RUN_FILE, SPENT_FILE):
+        kind = special_file_kind(folder / name)
+        if kind:
+            raise RunError(
+                f"{folder / name}: is {kind}, not a regular file; remove it and run the study again"
+            )
+
+
 def _die_with_parent() -> None:
     """Child pre-exec hook: get SIGKILL when the runner dies (Linux prctl).
 
@@ -194,8 +224,23 @@ def interrupt_all() -> None:
     """Ask every running command to checkpoint and stop (SIGINT, as Ctrl-C would)."""
     with _LIVE_LOCK:
         for proc in _LIVE:
-            with contextlib.suppress(ProcessLookupError):
-                proc.send_signal(signal.SIGINT)
+            _ask_to_stop(proc)
+
+
+def _ask_to_stop(proc: subprocess.Popen) -> None:
+    """Send ``proc`` SIGINT, and remember it: its end is then an interruption."""
+    proc.asked_to_stop = True
+    with contextlib.suppress(ProcessLookupError):
+        proc.send_signal(signal.SIGINT)
+
+
+def died_of_signal(status: int) -> str:
+    """``SIGSEGV (Segmentation fault)`` for the exit status ``-11`` of a killed command."""
+    try:
+        sig = signal.Signals(-status)
+    except ValueError:
+        return f"signal {-status}"
+    return f"{sig.name} ({signal.strsignal(sig) or 'unknown'})"
 
 
 def execute(run: Run, results: Path, threads: int = 1, cluster: str | None = None) -> RunRecord:
@@ -219,6 +264,7 @@ def execute(run: Run, results: Path, threads: int = 1, cluster: str | None = Non
         check_settings(run, folder)
         return RunRecord.load(folder)
     folder.mkdir(parents=True, exist_ok=True)
+    check_run_files(folder)
     env = dict(os.environ, NUMBA_NUM_THREADS=str(threads), PYTHONUNBUFFERED="1")
     env.pop(CLUSTER_VARIABLE, None)
     if cluster:
@@ -230,7 +276,14 @@ def execute(run: Run, results: Path, threads: int = 1, cluster: str | None = Non
                 continue  # finished by an earlier attempt
             log.write(f"$ evorbc-evolve {' '.join(cmd[len(CLI) :])}\n")
             log.flush()
-            status = _run_command(cmd, folder, env, log)
+            status, asked = _run_command(cmd, folder, env, log)
+            if status < 0 and not asked:
+                # A crash (SIGSEGV), the OOM killer (SIGKILL) or someone's kill: a failed
+                # run, not a stop the study asked for (docs/design.md section 15).
+                raise RunError(
+                    f"run {run.path}: {cmd[len(CLI)]} died of signal {died_of_signal(status)}; "
+                    f"its checkpoint, if any, is kept; see {folder / 'run.log'}"
+                )
             if status == EXIT_INTERRUPTED or status < 0:
                 raise RunInterrupted(str(run.path))
             if status != 0:
@@ -261,11 +314,12 @@ def execute(run: Run, results: Path, threads: int = 1, cluster: str | None = Non
     return RunRecord.load(folder)
 
 
-def _run_command(cmd: list[str], folder: Path, env: dict, log) -> int:
+def _run_command(cmd: list[str], folder: Path, env: dict, log) -> tuple[int, bool]:
     """Run one command to its end; add its wall and CPU time to the run's tally.
 
     Returns:
-        The exit status (negative: killed by that signal).
+        The exit status (negative: killed by that signal), and whether the runner asked
+        the command to stop (:func:`interrupt_all`, a cancelled Ray task).
     """
     start = time.monotonic()
     proc = subprocess.Popen(
@@ -291,7 +345,7 @@ def _run_command(cmd: list[str], folder: Path, env: dict, log) -> int:
             except KeyboardInterrupt:
                 # Stopped in this thread (a cancelled Ray task): ask the command to save
                 # its checkpoint, and wait for it.
-                proc.send_signal(signal.SIGINT)
+                _ask_to_stop(proc)
         proc.returncode = os.waitstatus_to_exitcode(status)
     finally:
         with _LIVE_LOCK:
@@ -301,7 +355,7 @@ def _run_command(cmd: list[str], folder: Path, env: dict, log) -> int:
     cpu += usage.ru_utime + usage.ru_stime
     text = json.dumps({"seconds": wall, "cpu_seconds": cpu})
     atomic_write(folder / SPENT_FILE, lambda f: f.write(text))
-    return proc.returncode
+    return proc.returncode, getattr(proc, "asked_to_stop", False)
 
 
 #: Wall and CPU seconds of an unfinished run's earlier attempts.

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from evorbc_ros.config import ConfigError, config_dir, load_yaml_mapping
+from offline_evolution import bounds
 
 #: The two approaches the paper compares (Sec. IV-C).
 APPROACHES = ("evorbc", "standard")
@@ -40,6 +41,12 @@ ARBITRATOR_KEYS = ("mapping", "generations")
 STANDARD_KEYS = ("generations", "equal_budget")
 SETTING_KEYS = ("approach", "robot", *REPERTOIRE_KEYS, *ARBITRATOR_KEYS, "equal_budget")
 TOP_KEYS = {"study", "title", "paper", "seeds", "grid", "fixed", "exclude", "compare", "figures"}
+#: The largest value of each count a setting holds.
+COUNT_BOUNDS = {
+    "generations": bounds.GENERATIONS,
+    "initial_batch": bounds.INITIAL_BATCH,
+    "iterations": bounds.ITERATIONS,
+}
 #: Figures ``evorbc-study report`` can draw (see :mod:`offline_evolution.study.figures`).
 FIGURES = ("curves", "boxplots", "repertoires", "heatmaps", "selection")
 
@@ -107,6 +114,23 @@ class Study:
             out.append((setting_id(chosen), values))
         return out
 
+    def check_runs(self, seeds: int, option: str) -> None:
+        """Refuse more than :data:`~offline_evolution.bounds.STUDY_RUNS` runs, before listing them.
+
+        Args:
+            seeds: seeds per setting; ``option`` names where they came from.
+
+        Raises:
+            ConfigError: naming the study file, the count and what to lower.
+        """
+        runs = len(self.settings()) * seeds
+        if runs > bounds.STUDY_RUNS:
+            raise ConfigError(
+                f"{self.source}: {len(self.settings()):,} settings x {seeds:,} seeds = "
+                f"{runs:,} runs, more than the bound of {bounds.STUDY_RUNS:,} a study "
+                f"(docs/design.md section 12); lower {option} or list fewer grid values"
+            )
+
     def runs(
         self,
         seeds: int | None = None,
@@ -121,6 +145,7 @@ class Study:
             only: keep the settings whose values match these (e.g. ``{"robot": "4ws-5"}``).
         """
         n = self.seeds if seeds is None else seeds
+        self.check_runs(n, "seeds (or give --seeds)" if seeds is None else "--seeds")
         out = []
         seen: set[str] = set()
         for sid, values in self.settings():
@@ -192,8 +217,10 @@ def parse_study(data: dict, source: str) -> Study:
     if not isinstance(name, str) or not name or "/" in name:
         raise ConfigError(f"{source}: study must be a name (a non-empty string without '/')")
     seeds = data.get("seeds")
-    if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
-        raise ConfigError(f"{source}: seeds must be an integer >= 1, got {seeds!r}")
+    if isinstance(seeds, bool) or not isinstance(seeds, int) or not 1 <= seeds <= bounds.SEEDS:
+        raise ConfigError(
+            f"{source}: seeds must be an integer from 1 to {bounds.SEEDS:,}, got {seeds!r}"
+        )
     grid = data.get("grid")
     if not isinstance(grid, dict) or not grid:
         raise ConfigError(f"{source}: grid must be a mapping of setting keys to lists of values")
@@ -202,6 +229,13 @@ def parse_study(data: dict, source: str) -> Study:
             raise ConfigError(f"{source}: grid.{key} must be a non-empty list")
         for v in values:
             check_value(key, v, f"{source}: grid.{key}")
+    # Counted before the combinations are listed: a grid of six 100-value lists is 10^12.
+    combinations = math.prod(len(v) for v in grid.values())
+    if combinations > bounds.STUDY_SETTINGS:
+        raise ConfigError(
+            f"{source}: grid has {combinations:,} combinations of settings, more than the "
+            f"bound of {bounds.STUDY_SETTINGS:,} (docs/design.md section 12); list fewer values"
+        )
     fixed = data.get("fixed", {}) or {}
     if not isinstance(fixed, dict):
         raise ConfigError(f"{source}: fixed must be a mapping of setting keys to values")
@@ -286,3 +320,8 @@ def check_value(key: str, value, where: str) -> None:
             raise ConfigError(f"{where}: expected true or false, got {value!r}")
     elif isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise ConfigError(f"{where}: expected an integer >= 1, got {value!r}")
+    elif value > COUNT_BOUNDS.get(key, value):
+        raise ConfigError(
+            f"{where}: expected an integer from 1 to {COUNT_BOUNDS[key]:,} "
+            f"(docs/design.md section 12), got {value:,}"
+        )

@@ -13,6 +13,7 @@ import os
 import sys
 from pathlib import Path
 
+from evorbc_ros.atomic_io import special_file_kind
 from evorbc_ros.config import ConfigError
 
 #: Set (to anything) to get the traceback of an internal error instead of one line.
@@ -78,15 +79,28 @@ def check_output_file(path: str, option: str, picture: bool = False) -> None:
     """Refuse an output ``path`` that could not be written, before the work that makes it.
 
     Missing folders are created (the writer would create them too). With ``picture``, the
-    suffix must name a format matplotlib writes, since it picks the format from it.
+    suffix must name a format matplotlib writes, since it picks the format from it. An
+    existing path must be a regular file (or a link to one, written through): a device, a
+    named pipe or a socket would be replaced by the write, not written to.
 
     Raises:
         ConfigError: one line naming ``option``, the path and the problem.
 
     """
+    if not str(path):
+        raise ConfigError(f"{option} '': an empty name, expected a file name")
     target = Path(path)
-    if target.is_dir():
+    kind = special_file_kind(target)
+    if kind == "a folder":
         raise ConfigError(f"{option} {path}: is a folder, expected a file name")
+    if kind:
+        # Every write renames a new file over its path, so a device or a pipe would be
+        # replaced, not written to (docs/design.md section 12, "Writing").
+        raise ConfigError(
+            f"{option} {path}: is {kind}, not a regular file; outputs are written as new "
+            "files, so give a file name"
+        )
+    target = Path(os.path.realpath(target))  # a link is written through to its target
     if picture:
         from matplotlib.backend_bases import FigureCanvasBase
 
