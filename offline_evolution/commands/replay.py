@@ -139,16 +139,20 @@ def controller_inputs(arb: ArbitratorFile, arb_path: Path, args: argparse.Namesp
     return repertoire, rep_path, settings
 
 
-def check_task(task, arb, arb_path: Path, repertoire, rep_path, allow_mismatch: bool) -> None:
+def check_task(
+    task, arb, arb_path: Path, repertoire, rep_path, allow_mismatch: bool, where: str = ""
+) -> None:
     """Refuse a task whose simulated robot or sensor layout is not ``arb``'s.
 
     The robot as :func:`check_design` compares it; the layout unless ``allow_mismatch``.
+    ``where`` names the task's file (a refusal then starts with it, and says which
+    arbitrator the layout was compared with).
     """
     check_design(task.describe(), arb, arb_path, repertoire, rep_path)
     try:
         arb.check_sensors(task.layout, task.settings.sensors, allow_mismatch, WAIVER)
     except ArbitratorError as e:
-        raise CliError(str(e)) from None
+        raise CliError(f"{where}: sensors: {e} ({arb_path})" if where else str(e)) from None
 
 
 def check_design(
@@ -201,7 +205,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
     )
     task = make_task(settings, arb.robot)
     try:
-        check_task(task, arb, arb_path, repertoire, rep_path, args.allow_mismatch)
+        check_task(task, arb, arb_path, repertoire, rep_path, args.allow_mismatch, where)
         if args.start == "random":
             rng = np.random.default_rng(args.seed)
             starts = np.concatenate([task.sample_starts(rng) for _ in range(args.episodes)])
