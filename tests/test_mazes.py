@@ -271,3 +271,14 @@ def test_hexapod_anywhere_is_the_hexapod_maze_with_starts_anywhere():
     lo_x, hi_x, lo_y, hi_y = maze.bounds()
     assert anywhere.start_x[1] - anywhere.start_x[0] > 0.9 * (hi_x - lo_x)
     assert anywhere.start_y[1] - anywhere.start_y[0] > 0.85 * (hi_y - lo_y)
+
+
+@pytest.mark.parametrize("far", [1e30, -1e300, 5e6])
+def test_a_wall_far_from_the_origin_is_refused_in_one_line(far):
+    # Fuzzed mazes: 1e30 m made numpy refuse an array size, 5e6 m asked for 3 GiB.
+    from evorbc_ros.config import config_dir
+
+    data = yaml.safe_load((config_dir() / "mazes" / "obstacle.yaml").read_text())
+    data["walls"][3][2] = far
+    with pytest.raises(ConfigError, match=r"m\.yaml: walls\[3\] reaches .* within 500 m"):
+        maze_from_dict(data, "m.yaml")

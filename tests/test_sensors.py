@@ -633,6 +633,7 @@ def test_exactly_one_tiling_sector_lights_near_every_edge():
         ({"range": 300.0}, "rangefinders.range must be a number > 0 and <= 50"),
         ({"rays": 10**6, "field_of_view_deg": 30.0}, "rays must be an integer from 1 to 100"),
         ({"angles_deg": [0.0] * 361}, "angles_deg must be a list of 1 to 360 numbers"),
+        ({"mount_radius": 1e300}, "mount_radius must be a number >= 0 and <= 50"),
     ],
 )
 def test_a_layout_that_would_exhaust_the_machine_is_refused(change, needle):
@@ -641,4 +642,14 @@ def test_a_layout_that_would_exhaust_the_machine_is_refused(change, needle):
     data = yaml.safe_load((config_dir() / "sensors" / "4ws.yaml").read_text())
     data["rangefinders"].update(change)
     with pytest.raises(ConfigError, match=re.escape(needle)):
+        SensorLayout.from_dict(data, "layout.yaml")
+
+
+def test_a_motion_window_of_1e300_s_is_refused():
+    # It ended in OverflowError (float infinity to integer) when the window was counted.
+    data = yaml.safe_load((config_dir() / "sensors" / "4ws-p8m.yaml").read_text())
+    data["motion"]["window"] = 1e300
+    with pytest.raises(
+        ConfigError, match=re.escape("motion.window must be a number > 0 and <= 60")
+    ):
         SensorLayout.from_dict(data, "layout.yaml")

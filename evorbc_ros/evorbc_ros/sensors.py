@@ -200,7 +200,11 @@ class SensorLayout:
                     d.get("range"), "rangefinders.range", source, maximum=MAX_RANGE
                 ),
                 mount_radius=_positive(
-                    d.get("mount_radius", 0.0), "rangefinders.mount_radius", source, allow_zero=True
+                    d.get("mount_radius", 0.0),
+                    "rangefinders.mount_radius",
+                    source,
+                    allow_zero=True,
+                    maximum=MAX_RANGE,
                 ),
                 field_of_view=math.radians(
                     _positive(
@@ -208,6 +212,7 @@ class SensorLayout:
                         "rangefinders.field_of_view_deg",
                         source,
                         allow_zero=True,
+                        maximum=360.0,
                     )
                 ),
                 rays=rays,
@@ -222,7 +227,9 @@ class SensorLayout:
             centres = _number_list(d.get("centres_deg"), "goal_sectors.centres_deg", source)
             gs = GoalSectorLayout(
                 tuple(math.radians(c) for c in centres),
-                math.radians(_positive(d.get("width_deg"), "goal_sectors.width_deg", source)),
+                math.radians(
+                    _positive(d.get("width_deg"), "goal_sectors.width_deg", source, maximum=360.0)
+                ),
             )
         bearing = data.get("goal_bearing", False)
         if not isinstance(bearing, bool):
@@ -231,8 +238,8 @@ class SensorLayout:
         if "motion" in data:
             d = _mapping(data["motion"], "motion", source, {"window", "distance"})
             motion = MotionLayout(
-                window=_positive(d.get("window"), "motion.window", source),
-                distance=_positive(d.get("distance"), "motion.distance", source),
+                window=_positive(d.get("window"), "motion.window", source, maximum=60.0),
+                distance=_positive(d.get("distance"), "motion.distance", source, maximum=MAX_RANGE),
             )
         layout = cls(rf, gs, bearing, motion)
         if layout.n_inputs == 0:

@@ -145,6 +145,11 @@ class Maze:
         }
 
 
+#: How far from the origin a wall may reach (m): a maze a kilometre across, where the
+#: shipped ones are 11 m.
+MAX_COORDINATE = 500.0
+
+
 def _numbers(value, count: int, where: str, source: str) -> tuple[float, ...]:
     if (
         not isinstance(value, (list, tuple))
@@ -194,6 +199,15 @@ def maze_from_dict(data: dict, source: str) -> Maze:
     # From the count, before any geometry: checking and simulating cost time in the walls.
     MAZE_WALLS.check(len(walls), source, ConfigError, "in walls")
     segments = np.array([_numbers(w, 4, f"walls[{k}]", source) for k, w in enumerate(walls)])
+    # The simulated sensors' lookup tables grow with the maze's size: a wall ending at
+    # 1e30 m asked numpy for more than it can index, one at 5e6 m for 3 GiB.
+    far = np.abs(segments).max(axis=1)
+    if far.max() > MAX_COORDINATE:
+        k = int(np.argmax(far))
+        raise ConfigError(
+            f"{source}: walls[{k}] reaches {far[k]:.3g} m from the origin; a maze lies within "
+            f"{MAX_COORDINATE:g} m of it"
+        )
     lengths = np.hypot(segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1])
     if np.any(lengths <= 0):
         k = int(np.argmin(lengths))
