@@ -633,7 +633,7 @@ def test_exactly_one_tiling_sector_lights_near_every_edge():
         ({"range": 300.0}, "rangefinders.range must be a number > 0 and <= 50"),
         ({"rays": 10**6, "field_of_view_deg": 30.0}, "rays must be an integer from 1 to 100"),
         ({"angles_deg": [0.0] * 361}, "angles_deg must be a list of 1 to 360 numbers"),
-        ({"mount_radius": 1e300}, "mount_radius must be a number >= 0 and <= 50"),
+        ({"mount_radius": 300.0}, "mount_radius must be a number >= 0 and <= 2"),
     ],
 )
 def test_a_layout_that_would_exhaust_the_machine_is_refused(change, needle):

@@ -204,7 +204,7 @@ class SensorLayout:
                     "rangefinders.mount_radius",
                     source,
                     allow_zero=True,
-                    maximum=MAX_RANGE,
+                    maximum=MAX_MOUNT_RADIUS,
                 ),
                 field_of_view=math.radians(
                     _positive(
@@ -306,6 +306,9 @@ def _positive(
 # each cycle fit the machine. A 300 m range asked for 1.4 GiB at once.
 #: The longest rangefinder range (m): beyond the largest maze.
 MAX_RANGE = 50.0
+#: How far from the robot's centre a rangefinder may sit (m): a fuzzed 300 m mount
+#: radius (a beam angle swapped into it) cast every ray from far outside the maze.
+MAX_MOUNT_RADIUS = 2.0
 #: Rays per rangefinder, and rangefinders or goal sectors per layout.
 MAX_RAYS, MAX_DIRECTIONS = 100, 360
 
