@@ -150,6 +150,8 @@ def gene_out_of_range(a):
         (None, {"solution": gene_out_of_range}, "solution (genes) must lie in [-1.0, 1.0]"),
         (None, {"measures": lambda a: a + 100.0}, "measures (behaviour) must lie inside"),
         (None, {"heading": lambda a: a[:-1]}, "heading has shape"),
+        (None, {"objective": lambda a: a * 1e6}, "objective (quality) must lie in [0, 1]"),
+        (None, {"heading": lambda a: a + 1e6}, "heading must lie within 1000 rad"),
         ({"evaluations": "abc"}, {}, "evaluations must be a whole number"),
         ({"evaluations": 10**9}, {}, "evaluations must be a whole number from 0 to 80"),
         ({"emitter": {"x": 1}}, {}, "emitter must hold the state of its random generator"),

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from evorbc_ros.repertoire_checks import HEADING_LIMIT, QUALITY_RANGES
 from evorbc_ros.robots.primitive import GENE_HIGH, GENE_LOW
 from offline_evolution.repertoire.settings import MapElitesSettings
 
@@ -39,7 +40,7 @@ def header_problem(header: dict, settings: MapElitesSettings) -> str | None:
 
 
 def arrays_problem(
-    arrays: dict[str, np.ndarray], n_genes: int, layout: dict, evaluations: int
+    arrays: dict[str, np.ndarray], n_genes: int, layout: dict, evaluations: int, metric: str
 ) -> str | None:
     """The first problem with a checkpoint's elites, or None.
 
@@ -48,6 +49,8 @@ def arrays_problem(
             ``heading (n,)`` (rad), as :meth:`MapElites.save` writes them.
         layout: the run's archive layout; every behaviour must lie inside it.
         evaluations: the header's count; there cannot be more elites than evaluations.
+        metric: the run's quality metric; every objective must lie in its range, and every
+            heading within ``HEADING_LIMIT`` (the repertoire written at the end must load).
 
     """
     for name in ("solution", "objective", "measures", "heading"):
@@ -68,6 +71,12 @@ def arrays_problem(
     genes, behaviour = arrays["solution"], arrays["measures"]
     if n and (genes.min() < GENE_LOW or genes.max() > GENE_HIGH):
         return f"solution (genes) must lie in [{GENE_LOW}, {GENE_HIGH}]"
+    q_low, q_high = QUALITY_RANGES[metric]
+    quality = arrays["objective"]
+    if n and (quality.min() < q_low or quality.max() > q_high):
+        return f"objective (quality) must lie in [{q_low:g}, {q_high:g}], the range of {metric}"
+    if n and np.abs(arrays["heading"]).max() > HEADING_LIMIT:
+        return f"heading must lie within {HEADING_LIMIT:g} rad"
     low, high = np.asarray(layout["low"]), np.asarray(layout["high"])
     if not np.all((behaviour >= low) & (behaviour < high)):
         return "measures (behaviour) must lie inside the archive"

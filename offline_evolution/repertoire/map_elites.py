@@ -404,7 +404,7 @@ class MapElites:
             # the centroids; elites filed under other cells would silently change the run.
             raise CheckpointError(f"{path}: its CVT centroids differ from this run's")
         problem = header_problem(header, self.settings) or arrays_problem(
-            arrays, len(self.parameters), self.layout, header["evaluations"]
+            arrays, len(self.parameters), self.layout, header["evaluations"], self.settings.metric
         )
         if problem is None:
             try:
