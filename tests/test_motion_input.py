@@ -48,7 +48,7 @@ def test_a_layout_with_motion_names_it_last_and_reads_back_the_same():
     ("motion", "message"),
     [
         ({"window": 0, "distance": 0.1}, "layout.yaml: motion.window must be a number > 0"),
-        ({"window": 1.0}, "layout.yaml: motion.distance must be a number > 0, got None"),
+        ({"window": 1.0}, "layout.yaml: motion.distance must be a number > 0 and <= 50, got None"),
         ({"window": 1.0, "distance": 0.1, "speed": 2}, "unknown key motion.speed"),
         ([1.0, 0.1], "layout.yaml: motion must be a mapping"),
     ],

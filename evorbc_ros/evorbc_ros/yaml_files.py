@@ -34,9 +34,9 @@ from yaml.resolver import Resolver
 from evorbc_ros.input_files import gc_paused
 from evorbc_ros.limits import NESTING, Limit
 
-try:  # libyaml's parser: the same events as pyyaml's, several times faster
+if yaml.__with_libyaml__:  # libyaml's parser: the same events as pyyaml's, several times faster
     from yaml._yaml import CParser as _Parser
-except ImportError:  # pragma: no cover - pyyaml built without libyaml
+else:  # pragma: no cover - pyyaml built without libyaml
     from yaml.parser import Parser
     from yaml.reader import Reader
     from yaml.scanner import Scanner
