@@ -3,7 +3,8 @@
 Prints three tables:
   * maze files of 1,000 to 20,000 walls (the shipped obstacle maze plus short posts): load
     and check with ``yaml.safe_load`` (the loader before) and with ``load_maze`` (now);
-    time per wall should stay flat (linear);
+    time per wall should stay flat (linear); and the time to build the task's wall grid
+    for the 4ws-5 sensors (each wall indexes only the cells near it: linear too);
   * one big YAML file (a 20,000-wall maze): ``yaml.safe_load``, pyyaml's C loader, and the
     strict loader (:func:`evorbc_ros.yaml_files.parse_yaml`);
   * a synthetic 200,000-primitive repertoire (18 genes, as the hexapod's): ``json.loads``
@@ -72,6 +73,10 @@ def repertoire_text(n: int, genes: int = 18, seed: int = 0) -> str:
     return json.dumps({**meta, "primitives": columns})
 
 
+#: The 4ws-5 task's grid reach (m): its sensors' reach plus a step and a margin.
+GRID_REACH = 1.1
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeats", type=int, default=3)
@@ -79,8 +84,11 @@ def main() -> None:
     r = args.repeats
     print(machine())
 
-    print("\n| walls | safe_load + checks (s) | load_maze (s) | load_maze per 1,000 walls (ms) |")
-    print("|---:|---:|---:|---:|")
+    print(
+        "\n| walls | safe_load + checks (s) | load_maze (s) | load_maze per 1,000 walls (ms) "
+        "| wall grid (s) |"
+    )
+    print("|---:|---:|---:|---:|---:|")
     with tempfile.TemporaryDirectory() as tmp:
         for n in (1_000, 2_500, 5_000, 10_000, 20_000):
             text = maze_text(n)
@@ -88,7 +96,11 @@ def main() -> None:
             path.write_text(text)
             before = timed(lambda t=text: maze_from_dict(yaml.safe_load(t), "m.yaml"), r)
             after = timed(lambda p=path: load_maze(p), r)
-            print(f"| {n:,} | {before:.2f} | {after:.3f} | {1000 * after / n * 1000:.1f} |")
+            maze = load_maze(path)
+            maze.wall_grid(GRID_REACH)  # compile the grid kernels before timing
+            grid = timed(lambda m=maze: m.wall_grid(GRID_REACH), r)
+            per = 1000 * after / n * 1000
+            print(f"| {n:,} | {before:.2f} | {after:.3f} | {per:.1f} | {grid:.3f} |")
 
     text = maze_text(20_000)
     print(f"\nYAML, one file of {len(text) / 1e6:.1f} MB (a 20,000-wall maze)\n")

@@ -2,10 +2,12 @@
 file, quickly, without expanding anything (issue 39; docs/design.md section 12)."""
 
 import json
+import math
 import resource
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 import yaml
 
@@ -15,6 +17,7 @@ from evorbc_ros.defaults import default_arbitrator, default_repertoire
 from evorbc_ros.json_files import load_json_file, nesting_depth, parse_json
 from evorbc_ros.repertoire import RepertoireError
 from offline_evolution import cli
+from sim_bridge.geometry import box_distances
 from sim_bridge.maze import load_maze, maze_from_dict
 
 GIB = 1 << 30
@@ -199,6 +202,43 @@ def test_a_maze_of_many_walls_inside_the_limit_loads(tmp_path):
 def test_every_shipped_maze_is_within_the_limit():
     for path in (config_dir() / "mazes").glob("*.yaml"):
         assert len(load_maze(path).walls) < 1000, path
+
+
+def _brute_force_grid(maze, reach: float, cell: float):
+    """``(offsets, ids)`` of a wall grid by testing every cell against every wall."""
+    grid = maze.wall_grid(reach, cell)
+    nx, ny = grid.shape
+    cx = grid.origin[0] + (np.arange(nx) + 0.5) * cell
+    cy = grid.origin[1] + (np.arange(ny) + 0.5) * cell
+    gx, gy = (a.ravel() for a in np.meshgrid(cx, cy, indexing="ij"))
+    limit = reach + cell * math.sqrt(0.5)
+    near = np.stack([box_distances(gx, gy, b) <= limit for b in maze.boxes], axis=1)
+    return np.concatenate([[0], np.cumsum(near.sum(axis=1))]), np.nonzero(near)[1]
+
+
+@pytest.mark.parametrize(("reach", "cell"), [(1.1, 0.2), (0.5, 0.1), (3.05, 0.2)])
+def test_the_wall_grid_is_the_one_testing_every_cell_against_every_wall_gives(reach, cell):
+    posts = [[-5.0 + 0.005 * i, -0.55 + 0.0005 * i, -4.9 + 0.005 * i, -0.5] for i in range(2000)]
+    for maze in (
+        maze_from_dict(_maze(posts), "m"),
+        load_maze(config_dir() / "mazes" / "gaps.yaml"),
+    ):
+        grid = maze.wall_grid(reach, cell)
+        offsets, ids = _brute_force_grid(maze, reach, cell)
+        assert np.array_equal(grid.offsets, offsets) and np.array_equal(grid.ids, ids)
+
+
+def test_a_wide_maze_of_many_walls_replays_within_two_gib(tmp_path):
+    # 2,000 walls along y = 400 m: a grid of 16 M cells. Testing every cell against every
+    # wall took 286 s and 7.7 GB and failed; each wall now visits only the cells near it.
+    walls = [[-400 + 0.4 * k, 400, -400 + 0.4 * k + 0.3, 400] for k in range(2000)]
+    maze = tmp_path / "wide.yaml"
+    maze.write_text(yaml.safe_dump(_maze(walls)))
+    result = evolve_cli(
+        "replay", "--arbitrator", default_arbitrator(), "--maze", maze, "--json", timeout=120
+    )
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert json.loads(result.stdout)
 
 
 # -- JSON ------------------------------------------------------------------------------------
