@@ -34,12 +34,14 @@ def test_every_named_hostile_case_is_refused_in_one_line_naming_its_file(outcome
     named = [o for o in outcomes if o.case.name.startswith("named/")]
     assert len(named) >= 50
     # The named cases whose either outcome is right (a dangling link as a checkpoint is a
-    # fresh start) say so with expect None; every other must be refused.
+    # fresh start) say so with expect None; a few valid but extreme files must be accepted
+    # (a wide maze); every other must be refused.
     wrong = [
         f"{o.case.name}: {o.outcome} {o.message}"
         for o in named
-        if o.case.expect == "refused" and o.outcome != "refused"
+        if o.case.expect is not None and o.outcome != o.case.expect
     ]
+    assert sum(o.case.expect == "accepted" for o in named) >= 1
     assert not wrong, "\n".join(wrong)
 
 

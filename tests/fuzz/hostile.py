@@ -114,6 +114,14 @@ def maze_size_cases(big: bool) -> Iterator[Case]:
     n = 200_000 if big else 60_000
     walls = [[0.01 * i, -0.5, 0.01 * i, -0.4] for i in range(n)]
     yield case(f"named/maze/{n}-walls", "maze", {"f.yaml": maze_text(walls)})
+    # Within every limit, and so accepted: walls spread along y = 400 m make a wall grid of
+    # 16 M cells (0.2 m), which took 286 s and 7.7 GB when each cell was tested against
+    # each wall (docs/design.md section 12).
+    n = 2000 if big else 500
+    wide = [[-400 + 0.4 * k, 400, -400 + 0.4 * k + 0.3, 400] for k in range(n)]
+    tree = yaml.safe_load(base_text("maze", Path()).decode())
+    tree["walls"] += wide  # the obstacle maze, whose start lies within its own walls
+    yield case(f"named/maze/wide-{n}-walls", "maze", {"f.yaml": _yaml(tree)}, "accepted")
 
 
 # -- repertoires ---------------------------------------------------------------------------------
