@@ -58,13 +58,19 @@ lint: $(STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
 
+# Three workers on two cores, a test file each at a time (module fixtures such as the built
+# wheel are made once): the suite waits on 10 Hz ROS graphs, subprocesses and Ray clusters
+# more than it computes (a -n 3 run: 875 s of CPU in 525 s). The multi-process tests claim
+# their ROS domains (tests/ros_domains.py), so the workers never share a graph.
+WORKERS ?= -n 3 --dist loadfile
+
 test: lint
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q $(WORKERS)
 
 # The suite without the tests marked slow (Ray clusters, killed and resumed runs, full
 # budgets, the plugin package): a few minutes, for working on the code.
 test-fast: lint
-	$(PY) -m pytest -q -m "not slow"
+	$(PY) -m pytest -q -m "not slow" $(WORKERS)
 
 # The whole fuzz corpus (tests/fuzz): every named hostile file at full size (a 3 M-primitive
 # repertoire, a 16 GiB zip bomb) and 100 mutants of each format, loaded through the command

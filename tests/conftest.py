@@ -1,5 +1,6 @@
 """Shared fixtures."""
 
+import fcntl
 import os
 import signal
 
@@ -22,6 +23,17 @@ from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
 
 pytest_plugins = ["ros_helpers"]  # the `ros` fixture for in-process ROS 2 tests
+
+
+def pytest_collection_modifyitems(items):
+    """Run the files holding slow tests first, each file's tests in their own order.
+
+    ``make test`` hands whole files to three workers in this order; the slow files (wheel
+    and colcon installs, Ray clusters, ROS graphs) started first keep the last worker from
+    starting one alone at the end.
+    """
+    slow = {item.module for item in items if item.get_closest_marker("slow")}
+    items.sort(key=lambda item: item.module not in slow)
 
 
 @pytest.fixture(autouse=True)
@@ -104,14 +116,27 @@ def small_task_file(tmp_path):
 
 
 @pytest.fixture(scope="session")
-def serial_results(tmp_path_factory):
+def serial_results(tmp_path_factory, worker_id):
     """The tiny study (tests/study_helpers.py) run serially, uninterrupted: the reference
-    of the study-runner and Ray tests."""
-    folder = tmp_path_factory.mktemp("serial")
-    study = write_tiny_study(folder)
-    result = run_study("run", study, "--results", folder / "results", "--jobs", "1")
-    assert result.returncode == 0, result.stderr
-    assert "study tiny: 2 done, 0 running, 0 left" in result.stderr
+    of the study-runner and Ray tests (read only).
+
+    Under pytest-xdist each worker has its own session; the study (about 30 s) is run once
+    for all of them, in the run's shared temporary folder, by whichever worker needs it
+    first, while the others wait on its lock.
+    """
+    root = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        root = root.parent  # shared by the workers of one run
+    folder = root / "serial"
+    with open(root / "serial.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not (folder / "done").exists():
+            folder.mkdir(exist_ok=True)
+            study = write_tiny_study(folder)
+            result = run_study("run", study, "--results", folder / "results", "--jobs", "1")
+            assert result.returncode == 0, result.stderr
+            assert "study tiny: 2 done, 0 running, 0 left" in result.stderr
+            (folder / "done").touch()
     return folder / "results"
 
 

@@ -2,6 +2,7 @@
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 
@@ -88,16 +89,16 @@ def test_a_finished_run_holds_its_files_and_record(serial_results):
 
 
 @pytest.mark.slow
-def test_finished_runs_are_skipped_and_other_settings_refused(serial_results):
-    before = (serial_results / "approach-evorbc" / "seed-002" / "run.json").read_text()
-    again = run_study("run", serial_results.parent / "tiny.yaml", "--results", serial_results)
+def test_finished_runs_are_skipped_and_other_settings_refused(serial_results, tmp_path):
+    # A copy: the runner takes its lock in the folder, which other workers read meanwhile.
+    results = shutil.copytree(serial_results, tmp_path / "results")
+    study = shutil.copy(serial_results.parent / "tiny.yaml", tmp_path)
+    before = (results / "approach-evorbc" / "seed-002" / "run.json").read_text()
+    again = run_study("run", study, "--results", results)
     assert again.returncode == 0
     assert "0 runs to go" in again.stderr
-    assert (serial_results / "approach-evorbc" / "seed-002" / "run.json").read_text() == before
-    other = run_study(
-        "status", serial_results.parent / "tiny.yaml", "--results", serial_results,
-        "--generations", "30",
-    )  # fmt: skip
+    assert (results / "approach-evorbc" / "seed-002" / "run.json").read_text() == before
+    other = run_study("status", study, "--results", results, "--generations", "30")
     assert other.returncode == 1
     assert "was run with generations = 20, not 30; use another results folder" in other.stderr
 
