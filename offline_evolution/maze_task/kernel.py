@@ -30,6 +30,7 @@ With every factor 1 and every noise 0 the episode is the unperturbed one, bit fo
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numba as nb
 import numpy as np
@@ -47,6 +48,39 @@ NO_PRIMITIVE = onboard_mapping.NO_PRIMITIVE
 
 #: Controller modes.
 EVORBC, STANDARD = 0, 1
+
+
+class Traces(NamedTuple):
+    """What a recorded episode writes, cycle by cycle (all 1-sized when ``on`` is False).
+
+    Attributes:
+        on: record the episodes.
+        pose: ``(E, n_cycles + 1, 3)`` pose ``(x m, y m, heading rad)`` at each cycle's
+            start, and at the end in the row after the last cycle run.
+        choice: ``(E, n_cycles)`` the primitive run (-1 for a standard controller,
+            :data:`NO_PRIMITIVE` for a stop).
+        outputs: ``(E, n_cycles, n_outputs)`` the network's outputs.
+    """
+
+    on: bool
+    pose: np.ndarray
+    choice: np.ndarray
+    outputs: np.ndarray
+
+
+class WorldDraws(NamedTuple):
+    """Each episode's perturbed world (docs/design.md section 21), or none when ``on`` is False.
+
+    Attributes:
+        on: apply the draws; otherwise the arrays may be 1-sized and are not read.
+        params: ``(E, 4)`` wheel speed gain, latency (cycles), reading noise sd, dropout
+            probability.
+        keys: ``(E,)`` int64 key of each episode's noise.
+    """
+
+    on: bool
+    params: np.ndarray
+    keys: np.ndarray
 
 
 @nb.njit(cache=True)
@@ -118,26 +152,141 @@ def _candidates(m, x, y, world):
     )
 
 
+# The helpers of each cycle are inlined into the parallel loop: as calls, the kernel ran
+# 25 % fewer cycles/s (bench/bench_ab_hot_paths.py, 4ws_episodes).
+
+
+@nb.njit(cache=True, inline="always")
+def _world_draw(draws, e):
+    """``(gain, latency cycles, noise sd, dropout, key)`` of episode ``e``; nominal when off."""
+    if draws.on:
+        p = draws.params
+        return p[e, 0], int(p[e, 1]), p[e, 2], p[e, 3], draws.keys[e]
+    return 1.0, 0, 0.0, 0.0, np.int64(0)
+
+
+@nb.njit(cache=True, inline="always")
+def _sense(t, x, y, h, m, world, sensors, trail, inputs, noise_sd, dropout, key):
+    """Fill ``inputs`` with cycle ``t``'s readings at pose ``(x, y, h)`` in maze ``m``.
+
+    ``trail`` is the motion input's ring (``(W + 1, 2)`` positions in m): this cycle's
+    position goes in, the one ``W`` cycles earlier (the episode's first before that) is
+    compared with it. Returns the wall rows near the robot, which the step reuses.
+    """
+    window = sensors.motion_cycles  # 0: no motion input
+    rx, ry = x, y
+    if window > 0:
+        trail[t % (window + 1), 0] = x
+        trail[t % (window + 1), 1] = y
+        ref = max(t - window, 0) % (window + 1)
+        rx, ry = trail[ref, 0], trail[ref, 1]
+    cand = _candidates(m, x, y, world)
+    tx = world.targets[m, 0]
+    ty = world.targets[m, 1]
+    read_sensors(x, y, h, tx, ty, rx, ry, sensors, world.boxes, cand, inputs)
+    if noise_sd > 0.0 or dropout > 0.0:
+        _perturb_readings(inputs, sensors.ray_angles.shape[0], noise_sd, dropout, key, t)
+    return cand
+
+
+@nb.njit(cache=True, inline="always")
+def _think(g, t, inputs, values, buffers, recurrent, out, net):
+    """Network ``g``'s outputs for ``inputs`` into ``out`` (a recurrent one steps its state)."""
+    if recurrent:
+        activate_recurrent(g, inputs, buffers, t % 2, out, net)
+    else:
+        activate(g, inputs, values, out, net)
+
+
+@nb.njit(cache=True, inline="always")
+def _decide(out, controller, lim, command):
+    """Turn the network's outputs into ``command`` (in place); return the choice.
+
+    EvoRBC: the mapping's point and the nearest primitive's command; standard NEAT: the
+    outputs as genes, through the robot's gene matrix. Outputs that are not finite (or a
+    point that is not) run no primitive: a stop (:data:`NO_PRIMITIVE`). Returns the
+    primitive's index, -1 for a standard controller, or :data:`NO_PRIMITIVE`.
+    """
+    width = command.shape[0]
+    choice = -1
+    finite = True
+    for k in range(out.shape[0]):
+        finite = finite and math.isfinite(out[k])
+    if controller.mode == EVORBC and finite:
+        px, py = map_point(controller.map_kind, controller.map_params, out[0], out[1])
+        finite = math.isfinite(px) and math.isfinite(py)
+        if finite:
+            choice = _lookup(
+                px, py, controller.lookup_origin, controller.lookup_cell, controller.lookup_table
+            )
+            for c in range(width):
+                command[c] = controller.primitive_commands[choice, c]
+    elif finite:
+        gene_matrix = controller.gene_matrix
+        for c in range(width):
+            acc = 0.0
+            for k in range(out.shape[0]):
+                gene = 2.0 * min(max(out[k], 0.0), 1.0) - 1.0
+                acc += gene * gene_matrix[k, c]
+            command[c] = acc * controller.command_scale[c]
+    if finite and controller.speed_wheel_radius > 0.0:
+        command[0] = speed_through_wheels(command[0], controller.speed_wheel_radius)
+    if not finite:
+        halt(command, lim)  # no primitive: stop
+        return NO_PRIMITIVE
+    return choice
+
+
+@nb.njit(cache=True, inline="always")
+def _record(pose, choice_trace, output_trace, e, t, x, y, h, choice, out):
+    """Write cycle ``t`` of episode ``e`` into the arrays of :class:`Traces`."""
+    pose[e, t, 0] = x
+    pose[e, t, 1] = y
+    pose[e, t, 2] = h
+    choice_trace[e, t] = choice
+    for k in range(out.shape[0]):
+        output_trace[e, t, k] = out[k]
+
+
+@nb.njit(cache=True, inline="always")
+def _act(state, e, t, command, scaled, gain, pending, latency, lim, boxes, cand):
+    """Step robot ``e`` one cycle on ``command``, through a perturbed world if ``scaled``.
+
+    Every branch of :func:`_decide` set the speeds afresh this cycle. A wheel speed gain
+    scales the 4WS speed, and both v and omega of a differential drive (every wheel turns
+    faster by the same factor). With ``latency`` cycles, the command of ``latency`` cycles
+    ago is applied and this one queued in ``pending`` (a ring starting as stops).
+    """
+    if scaled:
+        command[0] *= gain
+        if command.shape[0] == 2:
+            command[1] *= gain
+    if latency > 0:
+        slot = t % latency
+        applied = pending[slot].copy()
+        pending[slot, :] = command
+        step_model(state, e, applied, lim, boxes, cand)
+    else:
+        step_model(state, e, command, lim, boxes, cand)
+
+
+@nb.njit(cache=True, inline="always")
+def _unchanged(state, e, before):
+    """Whether robot ``e``'s whole state (pose, speed, wheel angles) equals ``before``."""
+    for k in range(STATE_SIZE):  # noqa: SIM110 (a loop: no generators in compiled code)
+        if state[e, k] != before[k]:
+            return False
+    return True
+
+
 @nb.njit(cache=True, parallel=True)
 def run_episodes(
-    genome,
-    maze,
-    start,
-    n_cycles,
-    net,
-    world,
-    sensors,
-    controller,
-    lim,
-    record,
-    trace_pose,
-    trace_choice,
-    trace_outputs,
-    perturbed,
-    world_params,
-    noise_keys,
+    genome, maze, start, n_cycles, net, world, sensors, controller, lim, traces, draws
 ):
     """Run every episode ``e`` (genome ``genome[e]`` in maze ``maze[e]`` from ``start[e]``).
+
+    Each cycle: sense, think, decide, (record), act, then stop at the target or at a fixed
+    point.
 
     Args:
         genome, maze: ``(E,)`` network and maze index of each episode.
@@ -150,11 +299,8 @@ def run_episodes(
         lim: the robot's limits: :class:`~sim_bridge.four_ws_motion.MotionLimits` or
             :class:`~sim_bridge.diff_drive_motion.DiffLimits` (its state fits in
             ``STATE_SIZE`` columns, x, y and heading first).
-        record: fill ``trace_pose (E, n_cycles + 1, 3)``, ``trace_choice (E, n_cycles)`` and
-            ``trace_outputs (E, n_cycles, n_outputs)``; otherwise they may be 1-sized.
-        perturbed: apply ``world_params (E, 4)`` (wheel speed gain, latency in cycles,
-            reading noise sd, dropout probability) and ``noise_keys (E,)``; otherwise they
-            may be 1-sized and are not read.
+        traces: :class:`Traces`, filled when ``traces.on``.
+        draws: :class:`WorldDraws`, applied when ``draws.on``.
 
     Returns:
         ``(reached (E,) bool, cycles (E,) int64, final_distance (E,), initial_distance (E,),
@@ -169,46 +315,35 @@ def run_episodes(
     end = np.empty((n_ep, 2))
     state = np.zeros((n_ep, STATE_SIZE))
     max_slots = net.n_slots.max()
-    n_outputs = net.n_outputs
-    net_recurrent, net_slots = net.recurrent, net.n_slots
-    # Fields the loop reads every cycle, as locals: numba does not hoist NamedTuple loads.
-    boxes, targets, target_radius = world.boxes, world.targets, world.target_radius
-    mode, map_kind, map_params = controller.mode, controller.map_kind, controller.map_params
-    lookup_origin, lookup_cell = controller.lookup_origin, controller.lookup_cell
-    lookup_table, primitive_commands = controller.lookup_table, controller.primitive_commands
-    gene_matrix, command_scale = controller.gene_matrix, controller.command_scale
-    wheel_radius = controller.speed_wheel_radius
-    n_rangefinders = sensors.ray_angles.shape[0]
     window = sensors.motion_cycles  # 0: no motion input
+    # The traces' arrays as locals: stores into a NamedTuple's array inside the parallel
+    # loop were lost (numba 0.68; tests/test_motion_input.py and test_recurrent.py).
+    pose, choice_trace, output_trace = traces.pose, traces.choice, traces.outputs
     # Entries of a command: the robot's (4WS 5, differential drive 2).
-    width = primitive_commands.shape[1] if mode == EVORBC else gene_matrix.shape[1]
+    if controller.mode == EVORBC:
+        width = controller.primitive_commands.shape[1]
+    else:
+        width = controller.gene_matrix.shape[1]
     for e in nb.prange(n_ep):
         g = genome[e]
         m = maze[e]
-        tx = targets[m, 0]
-        ty = targets[m, 1]
+        tx = world.targets[m, 0]
+        ty = world.targets[m, 1]
         state[e, X] = start[e, 0]
         state[e, Y] = start[e, 1]
         state[e, HEADING] = start[e, 2]
         inputs = np.empty(sensors.n_inputs)
         values = np.empty(max_slots)
         # A recurrent network's state (activate_recurrent): 0 at the start of the episode.
-        recurrent = net_recurrent[g]
+        recurrent = net.recurrent[g]
         buffers = np.zeros((2, max_slots if recurrent else 1))
-        out = np.empty(n_outputs)
+        out = np.empty(net.n_outputs)
         # 4WS: (speed m/s, 4 steering angles rad); a stop keeps the last angles, as the
         # executor does, which start at 0. Differential drive: (v m/s, omega rad/s).
         command = np.zeros(width)
         before = np.empty(STATE_SIZE)
-        gain, latency, noise_sd, dropout, key = 1.0, 0, 0.0, 0.0, 0
-        if perturbed:
-            gain = world_params[e, 0]
-            latency = int(world_params[e, 1])
-            noise_sd = world_params[e, 2]
-            dropout = world_params[e, 3]
-            key = noise_keys[e]
-        # Commands still on their way to the wheels (latency): a ring of the last ones,
-        # starting as stops with the steering straight.
+        gain, latency, noise_sd, dropout, key = _world_draw(draws, e)
+        # Commands still on their way to the wheels (latency), starting as stops.
         pending = np.zeros((max(latency, 1), width))
         # The motion input's ring: position of cycle t in row t % (window + 1) (m).
         # (Rows past the episode's length are never written: a longer window reads p(0).)
@@ -220,97 +355,40 @@ def run_episodes(
             x = state[e, X]
             y = state[e, Y]
             h = state[e, HEADING]
-            rx, ry = x, y
-            if window > 0:
-                trail[t % (window + 1), 0] = x
-                trail[t % (window + 1), 1] = y
-                ref = max(t - window, 0) % (window + 1)
-                rx, ry = trail[ref, 0], trail[ref, 1]
-            cand = _candidates(m, x, y, world)
-            read_sensors(x, y, h, tx, ty, rx, ry, sensors, boxes, cand, inputs)
-            if noise_sd > 0.0 or dropout > 0.0:
-                _perturb_readings(inputs, n_rangefinders, noise_sd, dropout, key, t)
-            if recurrent:
-                activate_recurrent(g, inputs, buffers, t % 2, out, net)
-            else:
-                activate(g, inputs, values, out, net)
-            choice = -1
-            finite = True
-            for k in range(n_outputs):
-                finite = finite and math.isfinite(out[k])
-            if mode == EVORBC and finite:
-                px, py = map_point(map_kind, map_params, out[0], out[1])
-                finite = math.isfinite(px) and math.isfinite(py)
-                if finite:
-                    choice = _lookup(px, py, lookup_origin, lookup_cell, lookup_table)
-                    for c in range(width):
-                        command[c] = primitive_commands[choice, c]
-            elif finite:
-                for c in range(width):
-                    acc = 0.0
-                    for k in range(n_outputs):
-                        gene = 2.0 * min(max(out[k], 0.0), 1.0) - 1.0
-                        acc += gene * gene_matrix[k, c]
-                    command[c] = acc * command_scale[c]
-            if finite and wheel_radius > 0.0:
-                command[0] = speed_through_wheels(command[0], wheel_radius)
-            if not finite:
-                choice = NO_PRIMITIVE
-                halt(command, lim)  # no primitive: stop
-            if record:
-                trace_pose[e, t, 0] = x
-                trace_pose[e, t, 1] = y
-                trace_pose[e, t, 2] = h
-                trace_choice[e, t] = choice
-                for k in range(n_outputs):
-                    trace_outputs[e, t, k] = out[k]
+            cand = _sense(t, x, y, h, m, world, sensors, trail, inputs, noise_sd, dropout, key)
+            _think(g, t, inputs, values, buffers, recurrent, out, net)
+            choice = _decide(out, controller, lim, command)
+            if traces.on:
+                _record(pose, choice_trace, output_trace, e, t, x, y, h, choice, out)
             for k in range(STATE_SIZE):
                 before[k] = state[e, k]
-            if perturbed:
-                # Every branch above set the speeds afresh this cycle. A wheel speed gain
-                # scales the 4WS speed, and both v and omega of a differential drive
-                # (every wheel turns faster by the same factor).
-                command[0] *= gain
-                if width == 2:
-                    command[1] *= gain
-            if latency > 0:
-                # Apply the command of ``latency`` cycles ago and queue this one.
-                slot = t % latency
-                applied = pending[slot].copy()
-                pending[slot, :] = command
-                step_model(state, e, applied, lim, boxes, cand)
-            else:
-                step_model(state, e, command, lim, boxes, cand)
+            _act(state, e, t, command, draws.on, gain, pending, latency, lim, world.boxes, cand)
             dist = math.hypot(state[e, X] - tx, state[e, Y] - ty)
-            if dist <= target_radius[m]:
+            if dist <= world.target_radius[m]:
                 reached[e] = True
                 cycles[e] = t + 1
                 break
-            if not record and not perturbed:
-                # A fixed point: the whole state (pose, speed, wheel angles) came back
-                # unchanged, so every later cycle reads the same sensors, gets the same
-                # outputs from the network and makes the same step. A feed-forward network
-                # is stateless; a recurrent one must also have written the values it read
-                # (both buffers equal), so its next step repeats this one. A motion input
-                # reads the same (0) only once the whole window, and the position this
-                # cycle compared with, hold this position: more than ``window`` unchanged
-                # steps in a row. The episode's outcome is already known: stop here.
-                same = True
-                for k in range(STATE_SIZE):
-                    if state[e, k] != before[k]:
-                        same = False
-                        break
+            if not traces.on and not draws.on:
+                # A fixed point: the whole state came back unchanged, so every later cycle
+                # reads the same sensors, gets the same outputs from the network and makes
+                # the same step. A feed-forward network is stateless; a recurrent one must
+                # also have written the values it read (both buffers equal), so its next
+                # step repeats this one. A motion input reads the same (0) only once the
+                # whole window, and the position this cycle compared with, hold this
+                # position: more than ``window`` unchanged steps in a row. The episode's
+                # outcome is already known: stop here.
+                same = _unchanged(state, e, before)
                 still = still + 1 if same else 0
                 if same and recurrent:
-                    same = _same_state(buffers, net_slots[g])
+                    same = _same_state(buffers, net.n_slots[g])
                 if same and still > window:
                     break
         final_distance[e] = dist
         end[e, 0] = state[e, X]
         end[e, 1] = state[e, Y]
-        if record:
+        if traces.on:  # the pose the last cycle run reached
             last = cycles[e]
-            trace_pose[e, last, 0] = state[e, X]
-            trace_pose[e, last, 1] = state[e, Y]
-            trace_pose[e, last, 2] = state[e, HEADING]
+            pose[e, last, 0] = state[e, X]
+            pose[e, last, 1] = state[e, Y]
+            pose[e, last, 2] = state[e, HEADING]
     return reached, cycles, final_distance, initial_distance, end

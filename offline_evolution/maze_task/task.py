@@ -25,7 +25,13 @@ from offline_evolution.maze_task.base import (
     empty_traces,
     eq5_fitness,
 )
-from offline_evolution.maze_task.kernel import EVORBC, STANDARD, run_episodes
+from offline_evolution.maze_task.kernel import (
+    EVORBC,
+    STANDARD,
+    Traces,
+    WorldDraws,
+    run_episodes,
+)
 from offline_evolution.maze_task.perturbation import KINEMATIC
 from offline_evolution.maze_task.world import MazePiece, combine_pieces, maze_piece
 from offline_evolution.task_protocol import EpisodeResult
@@ -218,13 +224,8 @@ class MazeTask(MazeTaskBase):
                 self.sensors,
                 controller,
                 self.robot.limits,
-                record,
-                pose,
-                choice,
-                outputs,
-                world is not None,
-                params,
-                keys,
+                Traces(bool(record), pose, choice, outputs),
+                WorldDraws(world is not None, params, keys),
             )
         traces = (pose, choice, outputs) if record else None
         ends = (maze, start[:, :2], end)
