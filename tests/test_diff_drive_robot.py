@@ -21,6 +21,8 @@ from evorbc_ros.robots import registry
 from evorbc_ros.robots.diff_drive import DiffDriveGeometry
 from evorbc_ros.robots.settings_robots import PATH_VARIABLE, read_robot_file
 from evorbc_ros.twist_executor import TwistExecutor
+from sim_bridge.rosbag_io import BagReader, decode
+from sim_bridge.sensors import read_sensors
 
 BIN = os.path.dirname(sys.executable)
 BURGER = config_dir() / "robots" / "turtlebot3-burger.yaml"
@@ -182,7 +184,20 @@ USER_FILES = {
         mazes: [gaps]
         episode_time: 15.0
         samples_per_maze: 1
-        sensors: sensors/turtlebot3-burger.yaml
+        sensors: {folder}/sensors.yaml
+        """,
+    # The Burger's layout with rangefinders reaching 2.6 m from the body centre, past the
+    # simulated scanner's default 2.0 m: the graph must still read what offline reads.
+    "sensors.yaml": """\
+        rangefinders:
+          angles_deg: [0, 60, 120, 180, 240, 300]
+          range: 2.5
+          mount_radius: 0.105
+          field_of_view_deg: 0.0
+          rays: 1
+        goal_sectors:
+          centres_deg: [0, 90, 180, 270]
+          width_deg: 90
         """,
 }
 
@@ -194,7 +209,7 @@ def pipeline(tmp_path_factory):
     folder = root / "robots"
     for name, text in USER_FILES.items():
         if text is not None:
-            write(folder / name, text)
+            write(folder / name, text.replace("{folder}", str(folder)))
     neat = (config_dir() / "neat" / "4ws.ini").read_text()
     (folder / "neat.ini").write_text(neat.replace("pop_size              = 150", "pop_size = 16"))
     burger = BURGER.read_text()
@@ -272,11 +287,32 @@ def test_a_user_robot_file_drives_the_lockstep_graph_exactly_as_offline(pipeline
     cli(
         pipeline, "evorbc-sim", "--arbitrator", "a.json", "--repertoire", "r.json",
         "--result", "run.json", "--plot", "run.png", "--quiet", "--domain-id", "178",
+        "--bag", "bag",
     )  # fmt: skip
     got = json.loads((run / "run.json").read_text())
     assert got["robot"] == "burger-test" and got["episode_time"] == 15.0
     cycles = int(result.cycles[0])
     # Bit for bit: the Twist carries the offline command exactly.
     np.testing.assert_array_equal(np.array(got["trajectory"]), result.pose[0, : cycles + 1])
+    # And the rangefinders read what they read offline, every cycle, to the LaserScan's
+    # float32 precision: walls past the scanner's default 2 m (the layout reaches 2.6 m)
+    # too. The choices matched even when they read nothing there.
+    with BagReader(run / "bag") as bag:
+        readings = np.array(
+            [
+                decode(m.raw, "std_msgs/msg/Float64MultiArray").data
+                for m in bag.messages(["/evorbc/rangefinders"])
+            ]
+        )[:cycles]
+    maze = task.mazes[0]
+    walls = np.arange(len(maze.boxes), dtype=np.int64)
+    inputs = np.empty(task.sensors.n_inputs)
+    offline = []
+    for x, y, h in result.pose[0, :cycles]:
+        read_sensors(x, y, h, *maze.target, x, y, task.sensors, maze.boxes, walls, inputs)
+        offline.append(inputs[: readings.shape[1]].copy())
+    offline = np.array(offline)
+    assert np.sum((offline > 0) & (offline < 0.2)) >= 3  # walls 2.1-2.6 m from the centre
+    np.testing.assert_allclose(readings, offline, rtol=0, atol=1e-6)
     assert got["fitness"] == outcomes[0].fitness and got["reached"] == outcomes[0].reached
     assert np.ptp(np.array(got["trajectory"])[:, 0]) > 0.1  # it went somewhere

@@ -56,7 +56,14 @@ PARAMETERS = (
     spec("result_file", "", "write the episode result here (JSON)"),
     spec("progress_period", 10.0, "simulated seconds between progress lines", 0.1, 1e6),
     spec("laser_beams", 360, "kinematic robots: laser beams per scan over 360 deg", 1, 100000),
-    spec("laser_range", 2.0, "kinematic robots: laser range (m)", 0.01, 1000.0),
+    spec(
+        "laser_range",
+        2.0,
+        "kinematic robots: laser range (m); evorbc-sim and the launch file raise it to the "
+        "controller's rangefinder reach (mount radius + range) where that is farther",
+        0.01,
+        1000.0,
+    ),
     spec(
         "wheel_radius",
         0.0,

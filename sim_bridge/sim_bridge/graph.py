@@ -18,6 +18,7 @@ which nodes are lifecycle nodes (the launch file drives their transitions).
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,6 +26,7 @@ from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.defaults import default_arbitrator, paper_arbitrator, ships_controller
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.registry import DEFAULT_ROBOT
+from sim_bridge.bridge_parameters import PARAMETERS
 
 MODES = ("lockstep", "realtime")
 
@@ -168,6 +170,37 @@ def trained_episode_time(arbitrator: str) -> float | None:
     return float(value)
 
 
+def rangefinder_reach(arbitrator: str) -> float | None:
+    """The distance (m) from the body centre at which ``arbitrator``'s rangefinders stop.
+
+    Its sensor layout's mount radius plus range, or None for a file that records no
+    rangefinders or cannot be read (the nodes report a bad file themselves).
+    """
+    if not arbitrator:
+        return None
+    try:
+        with open(arbitrator, encoding="utf-8") as f:
+            rangefinders = json.load(f)["sensors"]["rangefinders"]
+        reach = float(rangefinders.get("mount_radius", 0.0)) + float(rangefinders["range"])
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
+    return reach if math.isfinite(reach) and reach > 0 else None
+
+
+def laser_range(arbitrator: str) -> dict:
+    """The bridge's ``laser_range`` for ``arbitrator``'s rangefinders, where the default is short.
+
+    A kinematic robot's simulated scanner sits at the body centre (2.0 m by default,
+    config/ros/sim_bridge.yaml); a rangefinder reads the beam along its axis, less its
+    mount radius. Rangefinders that reach farther (a large robot's: 0.6 m mount, 3 m
+    range) would read nothing past the scan's end where the offline episode reads a wall,
+    and the lockstep run would leave the offline one (docs/design.md section 9).
+    """
+    reach = rangefinder_reach(arbitrator)
+    default = next(p.default for p in PARAMETERS if p.name == "laser_range")
+    return {"laser_range": reach} if reach is not None and reach > default else {}
+
+
 def default_maze(robot: str) -> str:
     """The maze a robot runs in when none is named (its registration's: obstacle for 4WS)."""
     return registry.lookup(robot).maze
@@ -258,6 +291,7 @@ def sim_graph(
                         "seed": seed,
                         "result_file": result_file,
                         "episode_time": trained_episode_time(arbitrator) or "",
+                        **laser_range(arbitrator),
                         **ready,
                     }
                 ),
