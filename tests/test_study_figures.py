@@ -9,7 +9,7 @@ from study_helpers import write_tiny_study
 
 from offline_evolution.study.figures import bin_time_grid
 from offline_evolution.study.progress import StudyProgress, format_duration
-from offline_evolution.study.results import FinishedRun, SettingResults, load_results
+from offline_evolution.study.results import RunResult, SettingResults, finished_runs
 from offline_evolution.study.selection import aggregate_selection
 from offline_evolution.study.spec import Run, load_study
 
@@ -52,9 +52,13 @@ def test_durations_read_naturally():
     ]  # fmt: skip
 
 
+def _result(summary, cpu=1.0, seconds=1.0, done=None, evolution_seconds=None) -> RunResult:
+    return RunResult(1, done, seconds, cpu, "", summary, evolution_seconds, np.zeros(0))
+
+
 def _setting(bin_size, eval_time, best, counts):
     runs = [
-        FinishedRun(None, {"summary": {"best_fitness": b, "repertoire": {"count": c}}})
+        _result({"best_fitness": b, "repertoire": {"count": c}})
         for b, c in zip(best, counts, strict=True)
     ]
     return SettingResults(
@@ -81,15 +85,15 @@ def test_bin_time_grid_puts_each_setting_in_its_cell_and_leaves_gaps_empty():
 @pytest.mark.slow
 def test_selection_pools_every_cycle_of_every_runs_nominal_replays(serial_results, tmp_path):
     study = load_study(write_tiny_study(tmp_path))
-    (setting,) = load_results(study, serial_results)
-    assert len(setting.runs) == 2
-    outputs, chosen, reach = aggregate_selection(setting.runs)
-    one = [aggregate_selection([r]) for r in setting.runs]
+    ((_, _, runs),) = finished_runs(study, serial_results)
+    assert len(runs) == 2
+    outputs, chosen, reach = aggregate_selection(runs)
+    one = [aggregate_selection([r]) for r in runs]
     # Pooled over the runs, in run order.
     assert np.array_equal(outputs, np.concatenate([o for o, _, _ in one]))
     assert np.array_equal(chosen, np.concatenate([c for _, c, _ in one]))
     assert reach == max(r for _, _, r in one)
-    for run, (o, c, r) in zip(setting.runs, one, strict=True):
+    for run, (o, c, r) in zip(runs, one, strict=True):
         rep = run.repertoire()
         assert len(o) == len(c) > 0
         assert np.all((o >= 0) & (o <= 1))  # mapping outputs
@@ -99,16 +103,7 @@ def test_selection_pools_every_cycle_of_every_runs_nominal_replays(serial_result
 
 
 def _costed(setting_id, approach, cpu, seconds, done, ran, evolution_seconds):
-    run = FinishedRun(
-        None,
-        {
-            "cpu_seconds": cpu,
-            "seconds": seconds,
-            "settings": {"generations": done},
-            "summary": {"generations": ran},
-        },
-    )
-    run.arbitrator_data = {"evolution": {"seconds": evolution_seconds}}  # no file needed
+    run = _result({"generations": ran}, cpu, seconds, done, evolution_seconds)
     values = {"approach": approach, "generations": 1000}
     return SettingResults(setting_id, values, [run])
 
@@ -120,12 +115,12 @@ def test_full_protocol_cost_scales_the_evolution_only_and_imputes_by_approach():
     evo = _costed("e", "evorbc", cpu=100.0, seconds=200.0, done=300, ran=300,
                   evolution_seconds=100.0)  # fmt: skip
     assert _fixed_share(evo.runs[0]) == pytest.approx(0.5)
-    assert _full_cpu(evo, evo.runs[0].record, 0.5) == pytest.approx(100 * (0.5 + 0.5 * 1000 / 300))
+    assert _full_cpu(evo, evo.runs[0], 0.5) == pytest.approx(100 * (0.5 + 0.5 * 1000 / 300))
     # Standard NEAT at equal budget: 300 asked, 325 run; the full run is 1025 generations.
     std = _costed("s", "standard", cpu=65.0, seconds=65.0, done=300, ran=325,
                   evolution_seconds=65.0)  # fmt: skip
     assert _fixed_share(std.runs[0]) == 0.0
-    assert _full_cpu(std, std.runs[0].record) == pytest.approx(65 * 1025 / 325)
+    assert _full_cpu(std, std.runs[0]) == pytest.approx(65 * 1025 / 325)
     # A setting without runs is costed at its own approach's measured mean.
     missing = SettingResults("m", {"approach": "standard", "generations": 1000})
     per_run = {"e": 500.0, "s": 200.0}

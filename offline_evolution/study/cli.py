@@ -5,8 +5,11 @@
     evorbc-study run metrics --results DIR --address ray://head:10001   (or RAY_ADDRESS)
     evorbc-study status robot-types --results DIR
     evorbc-study report robot-types --results DIR --out docs/study
+    evorbc-study compact robot-types --results DIR --out docs/study/robot-types.results.json
+    evorbc-study report robot-types --results docs/study/robot-types.results.json
 
 The results folder is the only record: each run's folder holds its files and ``run.json``.
+``compact`` keeps of it what the report needs, in one file the report reads in its place.
 A finished run is skipped, an unfinished one resumes from its checkpoint, so running the
 same command again after any interruption finishes the study with the same results.
 """
@@ -88,27 +91,43 @@ def build_parser() -> argparse.ArgumentParser:
                 help="Ray: times a run lost with its node is retried from its checkpoint (3)",
             )
     rep = sub.add_parser("report", help="figures, statistics and verdicts as Markdown")
-    _study_options(rep, protocol=False)
+    _study_options(rep, protocol=False, table=True)
     rep.add_argument(
         "--out", metavar="DIR", help="folder for STUDY.md and its figures (default: docs/study)"
     )
-    rep.add_argument(
-        "--replay-runs",
-        type=integer_in(1),
-        metavar="N",
-        help="replay at most N runs per setting for the selection heatmaps (default: all)",
+    com = sub.add_parser(
+        "compact", help="the study's result table: what the report needs, in one file"
     )
-    rep.set_defaults(func=cmd_report)
+    _study_options(com, protocol=False)
+    com.add_argument(
+        "--out", metavar="FILE", help="the table (default: docs/study/STUDY.results.json)"
+    )
+    com.add_argument(
+        "--source",
+        default="",
+        metavar="TEXT",
+        help="where the raw run folders are kept, for the report "
+        "(e.g. 'commit abc1234 under docs/study/runs')",
+    )
+    for parser, func in ((rep, cmd_report), (com, cmd_compact)):
+        parser.add_argument(
+            "--replay-runs",
+            type=integer_in(1),
+            metavar="N",
+            help="replay at most N runs per setting for the selection heatmaps (default: all)",
+        )
+        parser.set_defaults(func=func)
     return p
 
 
-def _study_options(p: argparse.ArgumentParser, protocol: bool = True) -> None:
+def _study_options(p: argparse.ArgumentParser, protocol: bool = True, table=False) -> None:
     p.add_argument("study", help="a shipped study (evorbc-study list) or a study file (.yaml)")
     p.add_argument(
         "--results",
         required=True,
-        metavar="DIR",
-        help="results folder: one folder per run, the single record of the study",
+        metavar="DIR|TABLE" if table else "DIR",
+        help="results folder: one folder per run, the single record of the study"
+        + ("; or the study's result table (evorbc-study compact)" if table else ""),
     )
     if not protocol:
         return
@@ -264,20 +283,40 @@ def cmd_run(args) -> int:
 
 
 def cmd_report(args) -> int:
-    """Write the study's report from its results folder."""
+    """Write the study's report from its results folder or its result table."""
     from offline_evolution.study.report import default_out, write_report
     from offline_evolution.study.spec import load_study
 
     study = load_study(args.study)
     results = Path(args.results)
-    if not results.is_dir():
-        raise StudyError(f"--results {results}: no such folder")
+    if not (results.is_dir() or results.is_file()):
+        raise StudyError(f"--results {results}: no such folder or result table")
     out = Path(args.out) if args.out else default_out()
     try:
         md = write_report(study, results, out, args.replay_runs)
     except ValueError as e:
         raise StudyError(str(e)) from None
     print(f"{study.name}: report {md}")
+    return 0
+
+
+def cmd_compact(args) -> int:
+    """Write the study's compact result table from its results folder."""
+    from offline_evolution.study.report import default_out, read_results
+    from offline_evolution.study.spec import load_study
+    from offline_evolution.study.table import write_table
+
+    study = load_study(args.study)
+    results = Path(args.results)
+    if not results.is_dir():
+        raise StudyError(f"--results {results}: no such folder")
+    out = Path(args.out) if args.out else default_out() / f"{study.name}.results.json"
+    settings, _ = read_results(study, results, args.replay_runs)
+    if not any(s.runs for s in settings):
+        raise StudyError(f"{results}: no finished run of study {study.name}")
+    write_table(study, settings, out, args.results, args.source, args.replay_runs)
+    runs = sum(len(s.runs) for s in settings)
+    print(f"{study.name}: {runs} runs of {len(settings)} settings in {out}")
     return 0
 
 

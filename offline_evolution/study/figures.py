@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import io
 import math
 import os
 from collections.abc import Sequence
@@ -18,8 +19,14 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.colors import LogNorm
 
+from evorbc_ros.atomic_io import atomic_path
 from offline_evolution.plots.repertoire import draw_repertoire, quality_norm
-from offline_evolution.study.results import SettingResults
+from offline_evolution.study.results import (
+    CHOSEN_BINS,
+    OUTPUT_BINS,
+    SelectionCounts,
+    SettingResults,
+)
 from sim_bridge.plotting import plt, save_figure
 
 
@@ -63,7 +70,7 @@ def fitness_curves(
         for s in settings:
             if (panel_key and s.values.get(panel_key) != panel) or not s.runs:
                 continue
-            curves = [r.history() for r in s.runs]
+            curves = [r.best_so_far for r in s.runs]
             length = min(len(c) for c in curves)
             c = np.array([np.maximum.accumulate(k[:length]) for k in curves])
             start = (shift or {}).get(s.values.get("approach", "evorbc"), 0)
@@ -110,14 +117,13 @@ def example_repertoires(
     path: str | os.PathLike,
     grid: tuple[str, str] | None = None,
 ) -> None:
-    """The first finished run's repertoire of each EvoRBC setting, on one colour scale.
+    """The example repertoire (first finished run's) of each EvoRBC setting, one colour scale.
 
     Args:
         grid: ``(row_key, column_key)`` to lay the panels out as a table (Fig. 13),
             else one row.
     """
-    shown = [(s, s.runs[0].repertoire()) for s in settings if s.runs]
-    shown = [(s, r) for s, r in shown if r is not None]
+    shown = [(s, s.example) for s in settings if s.runs and s.example is not None]
     if not shown:
         return
     if grid:
@@ -149,7 +155,27 @@ def example_repertoires(
         shrink=0.6,
         label=f"quality ({shown[0][1].metric})",
     )
-    save_figure(fig, path)
+    _save_palette(fig, path)
+
+
+def _save_palette(fig, path: str | os.PathLike) -> None:
+    """Save ``fig`` as a 256-colour PNG (atomically) and close it.
+
+    Thousands of anti-aliased markers make a full-colour PNG of the bin-time repertoires
+    2 MB; the palette one is a third of it and looks the same (docs/study.md).
+    """
+    if not str(path).lower().endswith(".png"):
+        save_figure(fig, path)
+        return
+    from PIL import Image
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, dpi=150, format="png")
+    plt.close(fig)
+    image = Image.open(buffer).convert("RGB")
+    image = image.quantize(colors=256, method=Image.Quantize.MEDIANCUT)
+    with atomic_path(path) as tmp:
+        image.save(tmp, format="PNG", optimize=True)
 
 
 def bin_time_grid(
@@ -195,37 +221,40 @@ def bin_time_heatmaps(settings: list[SettingResults], path: str | os.PathLike) -
     save_figure(fig, path)
 
 
-def selection_heatmaps(
-    panels: list[tuple[str, np.ndarray, np.ndarray, float]], path: str | os.PathLike
-) -> None:
+def selection_heatmaps(panels: list[tuple[str, SelectionCounts]], path: str | os.PathLike) -> None:
     """Fig. 14 rows 2-3: where the mapping outputs fell and which primitives ran.
 
     Args:
-        panels: per setting ``(label, outputs (k, 2) in [0, 1], chosen behaviours (k, 2) m,
-            half-width of the behaviour panel m)``, aggregated over the runs' controllers.
+        panels: per setting its label and its counts, pooled over the runs' controllers.
     """
     fig, axes = plt.subplots(
         2, len(panels), figsize=(4.0 * len(panels), 7.6), squeeze=False, layout="constrained"
     )
-    for j, (label, outputs, chosen, reach) in enumerate(panels):
+    for j, (label, counts) in enumerate(panels):
         ax = axes[0, j]
-        if len(outputs):
-            ax.hist2d(*outputs.T, bins=25, range=[[0, 1], [0, 1]], cmap="Blues", norm=LogNorm())
+        edges = np.linspace(0.0, 1.0, OUTPUT_BINS + 1)
+        _counts_mesh(ax, edges, counts.outputs, "Blues")
         ax.set_aspect("equal")
         ax.set_xlabel("m1")
         ax.set_ylabel("m2")
         ax.set_title(f"{label}: mapping outputs", fontsize=10)
         ax = axes[1, j]
-        if len(chosen):
-            ax.hist2d(
-                *chosen.T, bins=40, range=[[-reach, reach], [-reach, reach]], cmap="magma_r",
-                norm=LogNorm(),
-            )  # fmt: skip
+        edges = np.linspace(-counts.reach, counts.reach, CHOSEN_BINS + 1)
+        _counts_mesh(ax, edges, counts.chosen, "magma_r")
         ax.set_aspect("equal")
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)")
         ax.set_title(f"{label}: chosen primitives' displacement", fontsize=10)
     save_figure(fig, path)
+
+
+def _counts_mesh(ax, edges: np.ndarray, counts: np.ndarray, cmap: str) -> None:
+    """A 2-D histogram from its ``(bins, bins)`` counts (first axis x).
+
+    Drawn as ``hist2d`` draws it: log colour scale, empty cells blank.
+    """
+    if counts.sum() > 0:
+        ax.pcolormesh(edges, edges, counts.T.astype(float), cmap=cmap, norm=LogNorm())
 
 
 def _ordered(values) -> list:

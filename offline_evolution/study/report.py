@@ -1,8 +1,10 @@
 """``evorbc-study report``: a study's figures, statistics and verdicts, as Markdown.
 
-Everything comes from the results folder (the runs' ``run.json`` and files), so a report
-can be regenerated at any time, also while a study is still running (it then says how
-many runs each setting has so far).
+Everything comes from the results folder (the runs' ``run.json`` and files) or from the
+study's compact result table made from it (``table.py``), so a report can be regenerated
+at any time, also while a study is still running (it then says how many runs each setting
+has so far). Both are read into the same objects (``results.py``) first, so the report of
+a folder and that of its table are the same.
 """
 
 from __future__ import annotations
@@ -10,13 +12,14 @@ from __future__ import annotations
 import math
 import os
 import statistics
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write
 from offline_evolution.study import figures
-from offline_evolution.study.results import SettingResults, load_results, protocol
+from offline_evolution.study.results import RunResult, SettingResults, load_results, protocol
 from offline_evolution.study.spec import Study
 from offline_evolution.study.stats import ALPHA, ClaimResult, evaluate_claims
 
@@ -26,31 +29,60 @@ DEFAULT_FIGURES = ("curves", "boxplots", "repertoires")
 CLUSTERS = ((1, 2), (4, 16), (16, 32))
 
 
+def read_results(
+    study: Study, results: Path, replay_runs: int | None = None
+) -> tuple[list[SettingResults], dict | None]:
+    """A study's results from a results folder or, if ``results`` is a file, its table.
+
+    Args:
+        replay_runs: at most this many runs per setting are replayed for the selection
+            heatmaps (default: all); a table holds the counts it was made with.
+
+    Returns:
+        The settings, and the table's header (None for a folder).
+
+    Raises:
+        ValueError: a malformed table, or ``replay_runs`` with a table.
+    """
+    if results.is_file():
+        from offline_evolution.study.table import read_table
+
+        header, settings = read_table(results, study)
+        if replay_runs is not None:
+            raise ValueError(
+                f"--replay-runs: {results} is a result table, whose selection counts were "
+                "made when it was compacted (evorbc-study compact --replay-runs)"
+            )
+        return settings, header
+    selection = "selection" in (study.figures or DEFAULT_FIGURES)
+    return load_results(study, results, selection, replay_runs), None
+
+
 def write_report(study: Study, results: Path, out: Path, replay_runs: int | None = None) -> Path:
     """Draw the study's figures into ``out`` and write ``out/<study>.md``.
 
     Args:
-        replay_runs: at most this many runs per setting are replayed for the selection
-            heatmaps (default: all).
+        results: the results folder, or the study's compact result table.
+        replay_runs: see :func:`read_results`.
 
     Returns:
         The Markdown file.
     """
-    settings = load_results(study, results)
+    settings, header = read_results(study, results, replay_runs)
     if not any(s.runs for s in settings):
         raise ValueError(f"{results}: no finished run of study {study.name}")
     out.mkdir(parents=True, exist_ok=True)
     keys = list(study.grid)
     samples = [(s.values, s.best) for s in settings if s.runs]
     claims = evaluate_claims(study.compare, samples)
-    drawn = _draw(study, settings, keys, out, replay_runs)
-    text = _markdown(study, settings, keys, claims, drawn, results, out)
+    drawn = _draw(study, settings, keys, out)
+    text = _markdown(study, settings, keys, claims, drawn, (results, header), out)
     md = out / f"{study.name}.md"
     atomic_write(md, lambda f: f.write(text))
     return md
 
 
-def _draw(study: Study, settings, keys, out: Path, replay_runs) -> list[tuple[str, str]]:
+def _draw(study: Study, settings, keys, out: Path) -> list[tuple[str, str]]:
     """Draw the figures; returns ``(caption, file name)`` pairs."""
     from evorbc_ros.robots.registry import DEFAULT_ROBOT, lookup
 
@@ -101,15 +133,11 @@ def _draw(study: Study, settings, keys, out: Path, replay_runs) -> list[tuple[st
             )
         )
     if "selection" in wanted:
-        from offline_evolution.study.selection import aggregate_selection
-
         panels = []
         for s in settings:
-            if s.runs and s.values.get("approach", "evorbc") == "evorbc":
+            if s.runs and s.selection is not None:
                 label = figures.setting_label(s.values, [k for k in keys if k != "approach"])
-                panels.append(
-                    (label or s.values.get("robot", ""), *aggregate_selection(s.runs[:replay_runs]))
-                )
+                panels.append((label or s.values.get("robot", ""), s.selection))
         if panels:
             path = out / f"{name}-selection.png"
             figures.selection_heatmaps(panels, path)
@@ -144,15 +172,13 @@ def _p(p: float) -> str:
     return "< 0.001" if p < 0.001 else f"{p:.3f}"
 
 
-def _markdown(study, settings: list[SettingResults], keys, claims, drawn, results, out) -> str:
+def _markdown(study, settings: list[SettingResults], keys, claims, drawn, source, out) -> str:
     proto = protocol(settings)
     gens = ", ".join(map(str, proto["generations"])) or "n/a"
     lines = [
         f"# Study: {study.title}",
         "",
-        f"The paper's {study.paper}, rerun with `evorbc-study`. This page is written by "
-        f"`evorbc-study report {study.name} --results {results} --out {out}` from the "
-        "results folder alone; rerun it to update it.",
+        *_provenance(study, settings, source, out),
         "",
         "## Protocol",
         "",
@@ -229,6 +255,40 @@ def _markdown(study, settings: list[SettingResults], keys, claims, drawn, result
     return "\n".join(lines) + "\n"
 
 
+def _provenance(study: Study, settings, source: tuple[Path, dict | None], out) -> list[str]:
+    """Where the page comes from, and the commands that made its runs."""
+    results, header = source
+    report = f"`evorbc-study report {study.name} --results {results} --out {out}`"
+    if header is None:
+        made = f"{report} from the results folder alone"
+        folder = results
+    else:
+        made = (
+            f"{report} from the study's compact result table alone (every run's record and "
+            "highest fitness per generation, the example repertoires and the selection "
+            "counts; [docs/study.md](../study.md#compact-result-tables) describes it)"
+        )
+        folder = header["results"]
+    text = (
+        f"The paper's {study.paper}, rerun with `evorbc-study`. This page is written by "
+        f"{made}; rerun it to update it."
+    )
+    if header is not None and header["source"]:
+        text += f" The raw run folders are in {header['source']}."
+    proto = protocol(settings)
+    run = f"evorbc-study run {study.name} --results {folder}"
+    if proto["max_seeds"] != study.seeds:
+        run += f" --seeds {proto['max_seeds']}"
+    full = {s.values.get("generations") for s in settings}
+    if len(proto["generations"]) == 1 and full != set(proto["generations"]):
+        run += f" --generations {proto['generations'][0]}"
+    text += f" The runs were made by `{run}`"
+    if header is not None:
+        compact = f"evorbc-study compact {study.name} --results {folder} --out {results}"
+        text += f" and compacted by `{compact}`"
+    return [text + "."]
+
+
 def _claims_table(claims: list[ClaimResult]) -> list[str]:
     out = [
         "| claim | paper | comparison | means | p | adjusted p | effect | verdict |",
@@ -267,13 +327,13 @@ def _costs(study: Study, settings: list[SettingResults]) -> list[str]:
     for s in settings:
         if not s.runs:
             continue
-        wall = statistics.median(r.record["seconds"] for r in s.runs)
-        cpu = statistics.median(r.record["cpu_seconds"] for r in s.runs)
-        summary = s.runs[0].record.get("summary", {})
-        gens = summary.get("generations") or s.runs[0].record["settings"].get("generations")
-        scale = _full_cpu(s, {**s.runs[0].record, "cpu_seconds": 1.0}, _fixed_share(s.runs[0]))
+        wall = statistics.median(r.seconds for r in s.runs)
+        cpu = statistics.median(r.cpu_seconds for r in s.runs)
+        first = s.runs[0]
+        gens = first.summary.get("generations") or first.generations
+        scale = _full_cpu(s, replace(first, cpu_seconds=1.0), _fixed_share(first))
         per_run[s.setting_id] = cpu * scale
-        machine = s.runs[0].record.get("machine", "")
+        machine = first.machine
         rows.append(
             f"| {figures.setting_label(s.values, list(study.grid))} | {wall / 60:.1f} | "
             f"{cpu / 60:.1f} | {gens} | {cpu * scale / 60:.1f} | {machine} |"
@@ -308,7 +368,7 @@ def _costs(study: Study, settings: list[SettingResults]) -> list[str]:
         "|---|---|",
     ]
     longest = max(
-        (_full_cpu(s, r.record, _fixed_share(r)) for s in settings for r in s.runs),
+        (_full_cpu(s, r, _fixed_share(r)) for s in settings for r in s.runs),
         default=0.0,
     )
     for n, m in CLUSTERS:
@@ -317,7 +377,7 @@ def _costs(study: Study, settings: list[SettingResults]) -> list[str]:
     return [*out, ""]
 
 
-def _full_cpu(setting: SettingResults, record: dict, fixed: float = 0.0) -> float:
+def _full_cpu(setting: SettingResults, run: RunResult, fixed: float = 0.0) -> float:
     """A run's CPU seconds scaled to the full protocol's generations (the study file's).
 
     A standard-NEAT run at equal budget ran more generations than asked (the repertoire's
@@ -325,33 +385,31 @@ def _full_cpu(setting: SettingResults, record: dict, fixed: float = 0.0) -> floa
     any length, so the full run has it too. ``fixed``: the share of the run that does not
     grow with generations (an EvoRBC run's repertoire, :func:`_fixed_share`).
     """
-    done = record["settings"].get("generations")
+    done = run.generations
     full = setting.values.get("generations")
     if not (done and full):
-        return record["cpu_seconds"]
-    extra = _extra_generations(record)
+        return run.cpu_seconds
+    extra = _extra_generations(run)
     grows = (full + extra) / (done + extra)
-    return record["cpu_seconds"] * (fixed + (1.0 - fixed) * grows)
+    return run.cpu_seconds * (fixed + (1.0 - fixed) * grows)
 
 
-def _extra_generations(record: dict) -> int:
+def _extra_generations(run: RunResult) -> int:
     """Generations a run ran beyond those asked (standard NEAT at equal budget), else 0."""
-    asked = record["settings"].get("generations")
-    ran = record.get("summary", {}).get("generations")
+    asked = run.generations
+    ran = run.summary.get("generations")
     return ran - asked if asked and ran else 0
 
 
-def _fixed_share(run) -> float:
+def _fixed_share(run: RunResult) -> float:
     """The share of a run's time outside arbitrator evolution, in [0, 1].
 
     From the arbitrator file's evolution seconds against the run's wall seconds: the
     commands run one after the other, so the rest is the repertoire (EvoRBC) and the
     commands' start-up; CPU is assumed to split the same way.
     """
-    try:
-        evolution = float(run.arbitrator_data["evolution"]["seconds"])
-        total = float(run.record["seconds"])
-    except (OSError, KeyError, TypeError, ValueError):
+    evolution, total = run.evolution_seconds, run.seconds
+    if evolution is None or math.isnan(evolution):
         return 0.0
     return min(1.0, max(0.0, 1.0 - evolution / total)) if total > 0 else 0.0
 
@@ -373,7 +431,7 @@ def _imputed(setting: SettingResults, settings: list[SettingResults], per_run: d
 def _full_generations(study: Study, settings: list[SettingResults]) -> str:
     """`` (the full protocol: 1000, ...)`` for the protocol line of the report."""
     full = sorted({s.values.get("generations") for s in settings} - {None})
-    extra = sorted({_extra_generations(r.record) for s in settings for r in s.runs} - {0})
+    extra = sorted({_extra_generations(r) for s in settings for r in s.runs} - {0})
     text = f" (the full protocol: {', '.join(map(str, full))})" if full else ""
     if extra:
         text += (

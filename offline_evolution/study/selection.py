@@ -9,7 +9,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from offline_evolution.study.results import FinishedRun
+from offline_evolution.study.results import (
+    CHOSEN_BINS,
+    OUTPUT_BINS,
+    FinishedRun,
+    SelectionCounts,
+)
 
 
 def aggregate_selection(runs: list[FinishedRun]) -> tuple[np.ndarray, np.ndarray, float]:
@@ -51,3 +56,12 @@ def aggregate_selection(runs: list[FinishedRun]) -> tuple[np.ndarray, np.ndarray
         np.concatenate(chosen) if chosen else empty,
         reach,
     )
+
+
+def selection_counts(runs: list[FinishedRun]) -> SelectionCounts:
+    """The selection heatmaps' counts of ``runs`` (:func:`aggregate_selection`, binned)."""
+    outputs, chosen, reach = aggregate_selection(runs)
+    out, _, _ = np.histogram2d(*outputs.T, bins=OUTPUT_BINS, range=[[0, 1], [0, 1]])
+    extent = [[-reach, reach], [-reach, reach]]
+    ran, _, _ = np.histogram2d(*chosen.T, bins=CHOSEN_BINS, range=extent)
+    return SelectionCounts(len(runs), reach, out.astype(np.int64), ran.astype(np.int64))
