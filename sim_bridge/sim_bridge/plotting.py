@@ -1,4 +1,4 @@
-"""Shared plotting set-up: a headless backend and atomic PNG output."""
+"""Shared plotting set-up: a headless backend and atomic, compact PNG output."""
 
 from __future__ import annotations
 
@@ -9,15 +9,32 @@ import matplotlib
 matplotlib.use("Agg")  # no display on robots, CI or servers
 
 import matplotlib.pyplot as plt
+from PIL import Image
 
 from evorbc_ros.atomic_io import atomic_path
 
+#: Colours of a PNG written by :func:`save_figure`. The figures are line plots and maze
+#: drawings in a few colours plus their anti-aliasing: 256 palette colours look the same
+#: as 24-bit RGB and take about a third of the bytes (docs/results/README.md, "Figures").
+PALETTE_COLOURS = 256
+
+
+def shrink_png(path: str | os.PathLike) -> None:
+    """Rewrite the PNG at ``path`` in place with a 256-colour palette (atomically)."""
+    with Image.open(path) as im:
+        small = im.convert("RGB").quantize(PALETTE_COLOURS)
+    with atomic_path(path) as tmp:
+        small.save(tmp, format="png", optimize=True)
+
 
 def save_figure(fig, path: str | os.PathLike, dpi: int = 150) -> None:
-    """Save ``fig`` to ``path`` atomically and close it."""
+    """Save ``fig`` to ``path`` atomically and close it (a PNG with a palette)."""
+    kind = str(path).rsplit(".", 1)[-1].lower() or "png"
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=dpi, format=str(path).rsplit(".", 1)[-1].lower() or "png")
+        fig.savefig(tmp, dpi=dpi, format=kind)
+        if kind == "png":
+            shrink_png(tmp)
     plt.close(fig)
 
 
-__all__ = ["plt", "save_figure"]
+__all__ = ["plt", "save_figure", "shrink_png"]
