@@ -196,7 +196,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         )
     report = {
         "arbitrator": str(arb_path),
-        "kind": arb.kind,
+        "kind": arb.kind.name,
         "robot": arb.robot,
         "repertoire": rep_path,
         "mazes": [m.name for m in task.mazes],
@@ -219,7 +219,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         print(json.dumps(report, indent=1))
     else:
         print(
-            f"{arb_path}: {arb.kind} controller for {arb.robot}; {len(task.mazes)} mazes x "
+            f"{arb_path}: {arb.kind.name} controller for {arb.robot}; {len(task.mazes)} mazes x "
             f"{args.starts} random starts (seed {args.seed}); perturbations: {perturbation.name}"
         )
         _print_table(report["per_maze"], report["overall"])

@@ -123,7 +123,7 @@ def controller_inputs(arb: ArbitratorFile, arb_path: Path, args: argparse.Namesp
     from offline_evolution.maze_task.base import MazeTaskSettings
 
     repertoire, rep_path, warnings = None, None, []
-    if arb.kind == "evorbc":
+    if arb.kind.uses_repertoire:
         repertoire, rep_path, warnings = resolve_repertoire(
             arb, arb_path, args.repertoire, args.allow_mismatch
         )
@@ -188,7 +188,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
     check_outputs(written)
     check_distinct(written)
     arb = ArbitratorFile.load(arb_path)
-    if args.heatmap and arb.kind != "evorbc":
+    if args.heatmap and not arb.kind.uses_repertoire:
         raise CliError("--heatmap needs an EvoRBC arbitrator (standard NEAT has no primitives)")
     repertoire, rep_path, settings = controller_inputs(arb, arb_path, args)
     recorded = arb.evolution.get("task")
@@ -233,7 +233,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
             json.dumps(
                 {
                     "arbitrator": str(arb_path),
-                    "kind": arb.kind,
+                    "kind": arb.kind.name,
                     "robot": arb.robot,
                     "repertoire": rep_path,
                     "start": args.start,
@@ -247,7 +247,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
         )
     else:
         print(
-            f"{arb_path}: {arb.kind} controller for {arb.robot}"
+            f"{arb_path}: {arb.kind.name} controller for {arb.robot}"
             + (
                 f", {arb.mapping} mapping over {rep_path} ({len(repertoire)} primitives)"
                 if repertoire

@@ -303,7 +303,7 @@ def run(args: argparse.Namespace) -> int:
             bridge = start_graph(graph, args, arb.robot, arb_path, result_file)
             if not args.quiet:
                 print(
-                    f"evorbc-sim: {arb.kind} controller {arb_path} in maze {maze.name} "
+                    f"evorbc-sim: {arb.kind.name} controller {arb_path} in maze {maze.name} "
                     f"({args.mode}), ROS_DOMAIN_ID={env.get('ROS_DOMAIN_ID', '0')}",
                     file=sys.stderr,
                 )
