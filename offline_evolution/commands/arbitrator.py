@@ -10,23 +10,23 @@ from pathlib import Path
 
 from evorbc_ros.controller_kinds import EVORBC, STANDARD
 from evorbc_ros.repertoire import Repertoire
-from evorbc_ros.robots.registry import ROBOT_NAMES, lookup
+from evorbc_ros.robots.registry import lookup
 from offline_evolution import bounds
 from offline_evolution.commands.common import (
     CliError,
     EpisodeProgress,
+    add_resume_options,
     add_workers_option,
-    at_least,
     check_distinct,
     check_outputs,
     checkpoint_option,
-    count,
     default_checkpoint,
     exclusive_outputs,
     restart_from_scratch,
     running,
     write_then_discard,
 )
+from sim_bridge.cli_options import add_repertoire, add_robot, add_seed, add_task
 from sim_bridge.cli_support import check_output_file, integer_in
 
 
@@ -37,7 +37,7 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help="NEAT generations (default: the robot's run settings, Table I)",
     )
-    p.add_argument("--seed", type=count, default=0, metavar="N", help="random seed (0)")
+    add_seed(p, "random seed")
     p.add_argument("--out", required=True, metavar="FILE", help="arbitrator file to write (JSON)")
     p.add_argument(
         "--config",
@@ -45,27 +45,11 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         help="run settings (default: the robot's, e.g. config/arbitrator/4ws.yaml)",
     )
     p.add_argument("--neat-config", metavar="FILE.ini", help="NEAT settings (neat-python format)")
-    p.add_argument("--task", metavar="FILE.yaml", help="maze task settings")
+    add_task(p, "the one the run settings name")
     p.add_argument(
         "--plot", metavar="FILE.png", help="fitness-curve picture (default: OUT with .fitness.png)"
     )
-    p.add_argument(
-        "--checkpoint",
-        metavar="FILE",
-        help="resume checkpoint (default: OUT.checkpoint.json); a run resumes "
-        "from it automatically",
-    )
-    p.add_argument(
-        "--checkpoint-every",
-        type=at_least(1),
-        metavar="N",
-        help="generations between checkpoints",
-    )
-    p.add_argument(
-        "--restart",
-        action="store_true",
-        help="discard an existing checkpoint and start from scratch",
-    )
+    add_resume_options(p, ".checkpoint.json", "generations")
     p.add_argument(
         "--keep-checkpoint",
         action="store_true",
@@ -95,7 +79,7 @@ def add_parsers(sub) -> None:
         description="Evolve an arbitrator network with NEAT that maps sensor readings to a "
         "point of the repertoire's behaviour space (paper Sec. III-C).",
     )
-    arb.add_argument("--repertoire", required=True, metavar="FILE", help="repertoire file")
+    add_repertoire(arb)
     arb.add_argument("--mapping", choices=MAPPINGS, help="mapping function (default: polar)")
     _common_options(arb)
     arb.set_defaults(func=cmd_evolve, kind=EVORBC)
@@ -106,7 +90,7 @@ def add_parsers(sub) -> None:
         description="Evolve a network whose outputs are the robot's locomotion parameters, "
         "applied every control cycle (paper Sec. IV-D).",
     )
-    std.add_argument("--robot", required=True, choices=ROBOT_NAMES, help="robot type")
+    add_robot(std, "robot type", required=True)
     std.add_argument(
         "--equal-budget",
         action="store_true",
