@@ -20,13 +20,15 @@ from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 
+from evorbc_ros.controller_kinds import KINDS as CONTROLLER_KINDS
+from evorbc_ros.controller_kinds import ControllerKind
 from evorbc_ros.network import NetworkSpec
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.sensors import SensorLayout
 
-#: The controller kinds a task builds (the arbitrator file's ``kind``).
-KINDS = ("evorbc", "standard")
+#: The controller kinds a task builds, by the name an arbitrator file's ``kind`` gives.
+KINDS = CONTROLLER_KINDS
 
 
 class EpisodeResult(NamedTuple):
@@ -70,14 +72,19 @@ class ArbitratorTask(Protocol):
         ...
 
     def controller(
-        self, kind: str, repertoire: Repertoire | None = None, mapping: str | None = None
+        self,
+        kind: ControllerKind | str,
+        repertoire: Repertoire | None = None,
+        mapping: str | None = None,
     ) -> Any:
         """How network outputs become locomotion, for :meth:`evaluate`.
 
         Args:
-            kind: ``"evorbc"``: the network's 2 outputs in [0, 1] go through the mapping
-                function named ``mapping`` (``polar`` or ``cartesian``, paper eq. 7-9)
-                onto ``repertoire``'s behaviour space, and the nearest primitive runs;
+            kind: the record (:mod:`evorbc_ros.controller_kinds`) or its name, which
+                compares equal to it. ``"evorbc"``: the network's 2 outputs in [0, 1] go
+                through the mapping function named ``mapping`` (``polar`` or
+                ``cartesian``, paper eq. 7-9) onto ``repertoire``'s behaviour space, and
+                the nearest primitive runs;
                 ``"standard"``: the network's outputs (one per parameter, [0, 1]) are the
                 genes, mapped onto [-1, 1].
 

@@ -50,7 +50,7 @@ class Controller:
         self.spec = ArbitratorFile.load(self.arbitrator_path)
         self.warnings: list[str] = []
         self.repertoire = None
-        if self.spec.kind == "evorbc":
+        if self.spec.kind.uses_repertoire:
             self.repertoire_path = repertoire_path or str(default_repertoire(self.spec.robot))
             self.repertoire = Repertoire.load(self.repertoire_path)
             self.warnings = self.spec.check_repertoire(

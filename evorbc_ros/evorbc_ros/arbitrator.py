@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.controller_kinds import ControllerKind, controller_kind, direct_genes
 from evorbc_ros.input_files import ARBITRATOR_LIMIT
 from evorbc_ros.json_files import load_json_file
 from evorbc_ros.mapping import MAPPINGS, MappingFunction, PrimitiveLookup, choose_primitive
@@ -47,7 +48,6 @@ from evorbc_ros.sensors import SensorLayout
 
 FORMAT = "evorbc-arbitrator"
 VERSION = 1
-KINDS = ("evorbc", "standard")
 
 
 class ArbitratorError(ValueError):
@@ -56,9 +56,13 @@ class ArbitratorError(ValueError):
 
 @dataclass
 class ArbitratorFile:
-    """The contents of an arbitrator file."""
+    """The contents of an arbitrator file.
 
-    kind: str
+    ``kind`` may be given by name; it is kept as its record
+    (:mod:`evorbc_ros.controller_kinds`).
+    """
+
+    kind: ControllerKind
     robot: str
     network: NetworkSpec
     sensors: SensorLayout
@@ -68,12 +72,15 @@ class ArbitratorFile:
     control_period: float = 0.1
     evolution: dict[str, Any] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        self.kind = controller_kind(self.kind, "arbitrator", ArbitratorError)
+
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form written to files."""
         out = {
             "format": FORMAT,
             "version": VERSION,
-            "kind": self.kind,
+            "kind": self.kind.name,
             "robot": self.robot,
             "network": self.network.to_dict(),
             "inputs": self.sensors.input_names(),
@@ -82,7 +89,7 @@ class ArbitratorFile:
             "control_period": self.control_period,
             "evolution": self.evolution,
         }
-        if self.kind == "evorbc":
+        if self.kind.uses_repertoire:
             out["mapping"] = self.mapping
             out["repertoire"] = self.repertoire
         else:
@@ -116,9 +123,7 @@ class ArbitratorFile:
         problem = version_problem(data.get("version"), "arbitrator", VERSION)
         if problem:
             raise ArbitratorError(f"{source}: {problem}")
-        kind = data.get("kind")
-        if kind not in KINDS:
-            raise ArbitratorError(f"{source}: kind must be one of {', '.join(KINDS)}, got {kind!r}")
+        kind = controller_kind(data.get("kind"), source, ArbitratorError)
         for key in ("robot", "network", "sensors"):
             if key not in data:
                 raise ArbitratorError(f"{source}: missing key {key}")
@@ -149,7 +154,7 @@ class ArbitratorFile:
             control_period=_control_period(data, source),
             evolution=_evolution(data, source),
         )
-        if kind == "evorbc":
+        if kind.uses_repertoire:
             if data.get("mapping") not in MAPPINGS:
                 raise ArbitratorError(f"{source}: mapping must be one of {', '.join(MAPPINGS)}")
             rep = data.get("repertoire")
@@ -205,7 +210,7 @@ class ArbitratorFile:
             ArbitratorError: a repertoire for another robot or gene count (always), or
                 another fingerprint unless ``allow_mismatch``.
         """
-        if self.kind != "evorbc":
+        if not self.kind.uses_repertoire:
             return []
         head = f"repertoire {source} does not match the arbitrator"
         if repertoire.robot != self.robot:
@@ -323,7 +328,7 @@ class Arbitrator:
     """The onboard EvoRBC controller: inputs -> network -> mapping -> primitive."""
 
     def __init__(self, spec: ArbitratorFile, repertoire: Repertoire, grid_cells: int = 256):
-        if spec.kind != "evorbc":
+        if not spec.kind.uses_repertoire:
             raise ArbitratorError(
                 "a standard-NEAT controller has no primitives; use DirectController"
             )
@@ -364,7 +369,7 @@ class DirectController:
     """A standard-NEAT controller: the network outputs the locomotion genes directly."""
 
     def __init__(self, spec: ArbitratorFile):
-        if spec.kind != "standard":
+        if spec.kind.uses_repertoire:
             raise ArbitratorError("an EvoRBC arbitrator needs its repertoire; use Arbitrator")
         self.spec = spec
         self.network = spec.network.compile()
@@ -379,7 +384,4 @@ class DirectController:
         None when an output is not finite: no parameters to run, the robot must stop for
         the cycle (as an EvoRBC arbitrator's :data:`~evorbc_ros.mapping.NO_PRIMITIVE`).
         """
-        out = self.network.activate(inputs)
-        if not np.all(np.isfinite(out)):
-            return None
-        return 2.0 * np.clip(out, 0.0, 1.0) - 1.0
+        return direct_genes(self.network.activate(inputs))

@@ -230,10 +230,6 @@ class NetworkSpec:
         """
         return _compile(self)
 
-    def n_connections(self, enabled_only: bool = True) -> int:
-        """Number of (enabled) connections."""
-        return sum(1 for c in self.connections if c.enabled or not enabled_only)
-
 
 @dataclass(frozen=True)
 class CompiledNetwork:

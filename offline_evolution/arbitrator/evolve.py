@@ -33,6 +33,7 @@ import numpy as np
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.config import ConfigError, config_dir
+from evorbc_ros.controller_kinds import ControllerKind, controller_kind
 from evorbc_ros.input_files import SETTINGS_LIMIT, read_regular
 from evorbc_ros.network import ConnectionSpec, NetworkSpec, NodeSpec
 from evorbc_ros.repertoire import Repertoire, RepertoireError
@@ -97,9 +98,13 @@ LENGTH_ONLY = ("generations",)
 
 @dataclass(frozen=True)
 class EvolutionSettings:
-    """Everything that determines an evolution run's result."""
+    """Everything that determines an evolution run's result.
 
-    kind: str  # "evorbc" or "standard"
+    ``kind`` may be given by name; it is kept as its record
+    (:mod:`evorbc_ros.controller_kinds`) and written as its name.
+    """
+
+    kind: ControllerKind
     robot: str
     generations: int
     seed: int
@@ -127,9 +132,12 @@ class EvolutionSettings:
     initial_network: str | None = None
     initial_network_file: str | None = None
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "kind", controller_kind(self.kind))
+
     def as_dict(self) -> dict:
         """Plain-data form (checkpoints and arbitrator files)."""
-        return dataclasses.asdict(self)
+        return {**dataclasses.asdict(self), "kind": self.kind.name}
 
 
 @dataclass(frozen=True)
@@ -300,7 +308,7 @@ class Evolution:
             raise ConfigError("this task cannot train on generated mazes (no start_training)")
         # The simulated robot (PyBullet robots; None for the 4WS kinematics).
         self.simulation = self.task.describe()
-        if settings.kind == "evorbc":
+        if settings.kind.uses_repertoire:
             if repertoire is None:
                 raise ValueError("EvoRBC evolution needs a repertoire")
             try:
@@ -308,9 +316,7 @@ class Evolution:
             except RepertoireError:
                 self.close()
                 raise
-            n_outputs = 2
-        else:
-            n_outputs = len(self.task.parameter_specs)
+        n_outputs = settings.kind.n_outputs(len(self.task.parameter_specs))
         self.controller = self.task.controller(settings.kind, repertoire, settings.mapping)
         self.config = load_neat_config(settings.neat_file, self.task.layout.n_inputs, n_outputs)
         threshold = self.config.species_set_config.compatibility_threshold
@@ -791,9 +797,9 @@ def arbitrator_file(
     simulation = task.describe()
     if simulation is not None:
         evolution["simulation"] = simulation  # the robot the controller was evolved on
-    if s.kind == "evorbc":
+    if s.kind.uses_repertoire:
         return ArbitratorFile(
-            kind="evorbc",
+            kind=s.kind,
             robot=s.robot,
             network=result.selected_network,
             sensors=task.layout,
@@ -808,7 +814,7 @@ def arbitrator_file(
             },
         )
     return ArbitratorFile(
-        kind="standard",
+        kind=s.kind,
         robot=s.robot,
         network=result.selected_network,
         sensors=task.layout,

@@ -29,6 +29,7 @@ import neat
 
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.config import ConfigError
+from evorbc_ros.controller_kinds import ControllerKind, controller_kind
 from evorbc_ros.json_files import first_difference
 from evorbc_ros.network import ConnectionSpec, NetworkError, NetworkSpec
 from evorbc_ros.sensors import SensorLayout
@@ -42,7 +43,7 @@ def network_fingerprint(network: NetworkSpec) -> str:
 def load_initial_network(
     path: str | os.PathLike,
     robot: str,
-    kind: str,
+    kind: ControllerKind | str,
     mapping: str | None,
     layout: SensorLayout,
     config: neat.Config | None = None,
@@ -62,14 +63,15 @@ def load_initial_network(
     Raises:
         ConfigError: one line naming the file and what does not fit.
     """
+    kind = controller_kind(kind)
     try:
         arb = ArbitratorFile.load(path)
     except ArbitratorError as e:
         raise ConfigError(str(e)) from None
-    for what, theirs, ours in (("robot", arb.robot, robot), ("kind", arb.kind, kind)):
+    for what, theirs, ours in (("robot", arb.robot, robot), ("kind", arb.kind.name, kind.name)):
         if theirs != ours:
             raise ConfigError(f"{path}: its {what} is {theirs!r}, this run's is {ours!r}")
-    if kind == "evorbc" and arb.mapping != mapping:
+    if kind.uses_repertoire and arb.mapping != mapping:
         raise ConfigError(
             f"{path}: its mapping is {arb.mapping!r}, this run's is {mapping!r} "
             "(give --mapping to match)"

@@ -8,24 +8,25 @@ import sys
 from collections import deque
 from pathlib import Path
 
+from evorbc_ros.controller_kinds import EVORBC, STANDARD
 from evorbc_ros.repertoire import Repertoire
-from evorbc_ros.robots.registry import ROBOT_NAMES, lookup
+from evorbc_ros.robots.registry import lookup
 from offline_evolution import bounds
 from offline_evolution.commands.common import (
     CliError,
     EpisodeProgress,
+    add_resume_options,
     add_workers_option,
-    at_least,
     check_distinct,
     check_outputs,
     checkpoint_option,
-    count,
     default_checkpoint,
     exclusive_outputs,
     restart_from_scratch,
     running,
     write_then_discard,
 )
+from sim_bridge.cli_options import add_repertoire, add_robot, add_seed, add_task
 from sim_bridge.cli_support import check_output_file, integer_in
 
 
@@ -36,7 +37,7 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help="NEAT generations (default: the robot's run settings, Table I)",
     )
-    p.add_argument("--seed", type=count, default=0, metavar="N", help="random seed (0)")
+    add_seed(p, "random seed")
     p.add_argument("--out", required=True, metavar="FILE", help="arbitrator file to write (JSON)")
     p.add_argument(
         "--config",
@@ -44,27 +45,11 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         help="run settings (default: the robot's, e.g. config/arbitrator/4ws.yaml)",
     )
     p.add_argument("--neat-config", metavar="FILE.ini", help="NEAT settings (neat-python format)")
-    p.add_argument("--task", metavar="FILE.yaml", help="maze task settings")
+    add_task(p, "the one the run settings name")
     p.add_argument(
         "--plot", metavar="FILE.png", help="fitness-curve picture (default: OUT with .fitness.png)"
     )
-    p.add_argument(
-        "--checkpoint",
-        metavar="FILE",
-        help="resume checkpoint (default: OUT.checkpoint.json); a run resumes "
-        "from it automatically",
-    )
-    p.add_argument(
-        "--checkpoint-every",
-        type=at_least(1),
-        metavar="N",
-        help="generations between checkpoints",
-    )
-    p.add_argument(
-        "--restart",
-        action="store_true",
-        help="discard an existing checkpoint and start from scratch",
-    )
+    add_resume_options(p, ".checkpoint.json", "generations")
     p.add_argument(
         "--keep-checkpoint",
         action="store_true",
@@ -89,23 +74,23 @@ def add_parsers(sub) -> None:
     from evorbc_ros.mapping import MAPPINGS
 
     arb = sub.add_parser(
-        "arbitrator",
+        EVORBC.command,
         help="evolve an EvoRBC arbitrator for a repertoire (NEAT)",
         description="Evolve an arbitrator network with NEAT that maps sensor readings to a "
         "point of the repertoire's behaviour space (paper Sec. III-C).",
     )
-    arb.add_argument("--repertoire", required=True, metavar="FILE", help="repertoire file")
+    add_repertoire(arb)
     arb.add_argument("--mapping", choices=MAPPINGS, help="mapping function (default: polar)")
     _common_options(arb)
-    arb.set_defaults(func=cmd_evolve, kind="evorbc")
+    arb.set_defaults(func=cmd_evolve, kind=EVORBC)
 
     std = sub.add_parser(
-        "standard",
+        STANDARD.command,
         help="evolve a standard-NEAT controller (the baseline)",
         description="Evolve a network whose outputs are the robot's locomotion parameters, "
         "applied every control cycle (paper Sec. IV-D).",
     )
-    std.add_argument("--robot", required=True, choices=ROBOT_NAMES, help="robot type")
+    add_robot(std, "robot type", required=True)
     std.add_argument(
         "--equal-budget",
         action="store_true",
@@ -113,7 +98,7 @@ def add_parsers(sub) -> None:
         "for the 4WS robots, +455 for the hexapod)",
     )
     _common_options(std)
-    std.set_defaults(func=cmd_evolve, kind="standard")
+    std.set_defaults(func=cmd_evolve, kind=STANDARD)
 
 
 class _GenerationPrinter:
@@ -218,14 +203,14 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     }
     check_outputs(written)
     repertoire = None
-    if args.kind == "evorbc":
+    if args.kind.uses_repertoire:
         repertoire = Repertoire.load(args.repertoire)
         robot = repertoire.robot
     else:
         robot = args.robot
     run = load_run_settings(args.config, robot)
     generations = args.generations if args.generations is not None else run.generations
-    if args.kind == "standard" and args.equal_budget:
+    if not args.kind.uses_repertoire and args.equal_budget:
         generations += lookup(robot).equal_budget_generations
     neat_file = Path(args.neat_config) if args.neat_config else run.neat_path()
     task_settings = MazeTaskSettings.load(args.task or run.task_path())
@@ -240,9 +225,9 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     # The NEAT settings, the task's sensor layout and a network to start from, before any
     # work.
     layout = SensorLayout.load(config_dir() / task_settings.sensors)
-    n_outputs = 2 if args.kind == "evorbc" else lookup(robot).n_parameters
+    n_outputs = args.kind.n_outputs(lookup(robot).n_parameters)
     neat_config = load_neat_config(neat_file, layout.n_inputs, n_outputs)
-    mapping = (args.mapping or run.mapping) if args.kind == "evorbc" else None
+    mapping = (args.mapping or run.mapping) if args.kind.uses_repertoire else None
     initial_network = None
     if args.init_from:
         initial_network = load_initial_network(
@@ -303,12 +288,10 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             plot_fitness_history(
                 result.history,
                 plot,
-                title=f"{'EvoRBC' if args.kind == 'evorbc' else 'standard NEAT'}, "
-                f"{robot}, seed {args.seed}",
+                title=f"{args.kind.label}, {robot}, seed {args.seed}",
             )
 
         write_then_discard(checkpoint, write, discard=not args.keep_checkpoint)
-    label = "arbitrator" if args.kind == "evorbc" else "standard-NEAT controller"
     post = result.post_evaluation
     episodes = f"{post.episodes} post-evaluation episodes"
     if post.finalists:  # its figures are over both rounds (docs/design.md section 8)
@@ -317,7 +300,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
             f"finalists of {post.candidates} candidates)"
         )
     print(
-        f"{robot} {label}: best fitness {result.best_fitness:.3f} (generation "
+        f"{robot} {args.kind.noun}: best fitness {result.best_fitness:.3f} (generation "
         f"{result.best_generation + 1}); the controller written scores {post.fitness:.3f} and "
         f"reaches the target in {post.reached:.0%} of {episodes}; "
         f"{generations} generations in {result.seconds / 60:.1f} min "

@@ -157,6 +157,35 @@ class EpisodeProgress:
         )
 
 
+def add_resume_options(
+    parser: argparse.ArgumentParser, suffix: str, unit: str, every: int | None = None
+) -> None:
+    """``--checkpoint``, ``--checkpoint-every`` and ``--restart`` of a resumable run.
+
+    Args:
+        suffix: the default checkpoint's, after OUT (``.checkpoint.json``).
+        unit: what a run counts between checkpoints (``generations``).
+        every: the default of ``--checkpoint-every`` (None: the run settings').
+    """
+    parser.add_argument(
+        "--checkpoint",
+        metavar="FILE",
+        help=f"resume checkpoint (default: OUT{suffix}); a run resumes from it automatically",
+    )
+    parser.add_argument(
+        "--checkpoint-every",
+        type=at_least(1),
+        default=every,
+        metavar="N",
+        help=f"{unit} between checkpoints" + (f" (default: {every})" if every else ""),
+    )
+    parser.add_argument(
+        "--restart",
+        action="store_true",
+        help="discard an existing checkpoint and start from scratch",
+    )
+
+
 def add_workers_option(parser: argparse.ArgumentParser) -> None:
     """``--workers N``: processes for PyBullet simulations (results do not depend on it)."""
     parser.add_argument(

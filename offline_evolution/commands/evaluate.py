@@ -18,7 +18,7 @@ from evorbc_ros.defaults import (
     paper_arbitrator,
     ships_controller,
 )
-from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
+from evorbc_ros.robots.registry import DEFAULT_ROBOT
 from offline_evolution import bounds
 from offline_evolution.commands.common import (
     CliError,
@@ -29,8 +29,16 @@ from offline_evolution.commands.common import (
     count,
     exclusive_outputs,
 )
-from offline_evolution.commands.replay import check_task, controller_inputs
+from offline_evolution.commands.replay import REPERTOIRE_DEFAULT, check_task, controller_inputs
 from offline_evolution.mazes.held_out import HELD_OUT_SEED  # never trained on
+from sim_bridge.cli_options import (
+    add_arbitrator,
+    add_flag,
+    add_repertoire,
+    add_robot,
+    add_seed,
+    add_task,
+)
 from sim_bridge.cli_support import integer_in
 
 #: The suite word for the mazes the controller was trained on (its task's mazes).
@@ -48,24 +56,10 @@ def add_parsers(sub) -> None:
         "mazes, maze files or folders of them), under a perturbation set, and report per "
         "maze and overall.",
     )
-    p.add_argument(
-        "--arbitrator",
-        metavar="FILE",
-        help="arbitrator file (default: the shipped controller of --robot)",
-    )
-    p.add_argument(
-        "--robot",
-        choices=ROBOT_NAMES,
-        default=DEFAULT_ROBOT,
-        help="whose shipped controller, without --arbitrator",
-    )
-    p.add_argument(
-        "--paper",
-        action="store_true",
-        help="the paper-protocol controller shipped for --robot (trained on the paper's "
-        "mazes only) instead of its default one; not with --arbitrator",
-    )
-    p.add_argument("--repertoire", metavar="FILE", help="repertoire of an EvoRBC arbitrator")
+    add_arbitrator(p, "the shipped one for --robot")
+    add_robot(p, "whose shipped controller, without --arbitrator", DEFAULT_ROBOT)
+    add_flag(p, "--paper")
+    add_repertoire(p, REPERTOIRE_DEFAULT)
     p.add_argument(
         "--mazes",
         nargs="+",
@@ -89,20 +83,18 @@ def add_parsers(sub) -> None:
         "used for training)",
     )
     p.add_argument("--starts", type=at_least(1), default=20, metavar="N", help="per maze (20)")
-    p.add_argument("--seed", type=count, default=0, metavar="N", help="starts and worlds (0)")
+    add_seed(p, "starts and worlds")
     p.add_argument(
         "--perturb",
         default="none",
         metavar="none|realistic|FILE.yaml",
         help="perturbation set: a shipped one (config/perturbations/) or a file",
     )
-    p.add_argument(
-        "--task", metavar="FILE.yaml", help="episode time and sensors (default: the arbitrator's)"
-    )
+    add_task(p, "the arbitrator's; its episode time and sensors")
     p.add_argument("--plot", metavar="FILE.png", help="picture of the suite with every path")
     p.add_argument("--out", metavar="FILE.json", help="write the report as JSON")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
-    p.add_argument("--allow-mismatch", action="store_true", help="as for replay")
+    add_flag(p, "--allow-mismatch")
     p.set_defaults(func=cmd_evaluate)
 
 
@@ -196,7 +188,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         )
     report = {
         "arbitrator": str(arb_path),
-        "kind": arb.kind,
+        "kind": arb.kind.name,
         "robot": arb.robot,
         "repertoire": rep_path,
         "mazes": [m.name for m in task.mazes],
@@ -219,7 +211,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         print(json.dumps(report, indent=1))
     else:
         print(
-            f"{arb_path}: {arb.kind} controller for {arb.robot}; {len(task.mazes)} mazes x "
+            f"{arb_path}: {arb.kind.name} controller for {arb.robot}; {len(task.mazes)} mazes x "
             f"{args.starts} random starts (seed {args.seed}); perturbations: {perturbation.name}"
         )
         _print_table(report["per_maze"], report["overall"])

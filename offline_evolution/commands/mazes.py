@@ -7,9 +7,10 @@ import json
 import math
 from pathlib import Path
 
-from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
+from evorbc_ros.robots.registry import DEFAULT_ROBOT
 from offline_evolution import bounds
-from offline_evolution.commands.common import CliError, count
+from offline_evolution.commands.common import CliError
+from sim_bridge.cli_options import add_robot, add_seed
 from sim_bridge.cli_support import check_output_file, integer_in
 
 
@@ -23,7 +24,7 @@ def add_parsers(sub) -> None:
         "along walls, in the open or behind turns. Each is proven solvable by the "
         "clearance-aware path search and written as an ordinary maze file.",
     )
-    p.add_argument("--robot", choices=ROBOT_NAMES, default=DEFAULT_ROBOT, help="robot type")
+    add_robot(p, "robot type", DEFAULT_ROBOT)
     p.add_argument(
         "--count",
         type=integer_in(1, bounds.MAZES),
@@ -31,7 +32,7 @@ def add_parsers(sub) -> None:
         metavar="N",
         help=f"mazes (10; at most {bounds.MAZES:,})",
     )
-    p.add_argument("--seed", type=count, default=0, metavar="N", help="seed (0)")
+    add_seed(p, "seed")
     p.add_argument(
         "--serpentine",
         type=share,

@@ -8,11 +8,11 @@ import time
 from pathlib import Path
 
 from evorbc_ros.repertoire import Repertoire
-from evorbc_ros.robots.registry import ROBOT_NAMES, lookup
+from evorbc_ros.robots.registry import lookup
 from offline_evolution.commands.common import (
     CliError,
+    add_resume_options,
     add_workers_option,
-    at_least,
     check_distinct,
     check_outputs,
     checkpoint_option,
@@ -24,6 +24,7 @@ from offline_evolution.commands.common import (
     running,
     write_then_discard,
 )
+from sim_bridge.cli_options import add_robot
 from sim_bridge.cli_support import check_output_file
 
 
@@ -39,7 +40,7 @@ def add_parsers(sub) -> None:
         "Settings come from the robot's settings file (config/repertoire/4ws.yaml or "
         "hexapod.yaml: paper Table I) or --config; options given here override them.",
     )
-    rep.add_argument("--robot", choices=ROBOT_NAMES, help="robot type (default: from config)")
+    add_robot(rep, "robot type (default: from config)")
     rep.add_argument("--metric", choices=tuple(METRICS), help="quality metric")
     rep.add_argument(
         "--bin-size",
@@ -73,23 +74,7 @@ def add_parsers(sub) -> None:
     rep.add_argument("--out", required=True, metavar="FILE", help="repertoire file to write (JSON)")
     rep.add_argument("--plot", metavar="FILE.png", help="also draw the repertoire (Fig. 8 style)")
     rep.add_argument("--csv", metavar="FILE.csv", help="also export the primitives as CSV")
-    rep.add_argument(
-        "--checkpoint",
-        metavar="FILE",
-        help="resume checkpoint (default: OUT.checkpoint.npz); a run resumes from it automatically",
-    )
-    rep.add_argument(
-        "--checkpoint-every",
-        type=at_least(1),
-        default=100,
-        metavar="N",
-        help="iterations between checkpoints (default: 100)",
-    )
-    rep.add_argument(
-        "--restart",
-        action="store_true",
-        help="discard an existing checkpoint and start from scratch",
-    )
+    add_resume_options(rep, ".checkpoint.npz", "iterations", every=100)
     rep.add_argument("--quiet", action="store_true", help="no progress lines")
     add_workers_option(rep)
     rep.set_defaults(func=cmd_repertoire)

@@ -19,12 +19,21 @@ from offline_evolution.commands.common import (
     at_least,
     check_distinct,
     check_outputs,
-    count,
+)
+from sim_bridge.cli_options import (
+    add_arbitrator,
+    add_flag,
+    add_repertoire,
+    add_seed,
+    add_task,
 )
 from sim_bridge.robots.design import check_simulation, simulation_mismatch
 
 #: How a user lets another repertoire fingerprint or sensor layout through.
 WAIVER = "--allow-mismatch"
+#: Where an EvoRBC arbitrator's repertoire comes from without --repertoire
+#: (:func:`resolve_repertoire`).
+REPERTOIRE_DEFAULT = "the file it names, next to it, or the shipped one"
 
 
 def add_parsers(sub) -> None:
@@ -35,31 +44,22 @@ def add_parsers(sub) -> None:
         description="Replay an arbitrator (or a standard-NEAT controller) in the mazes it was "
         "evolved for.",
     )
-    p.add_argument("--arbitrator", required=True, metavar="FILE", help="arbitrator file")
-    p.add_argument(
-        "--repertoire",
-        metavar="FILE",
-        help="repertoire of an EvoRBC arbitrator (default: the file it names, next "
-        "to it, or the shipped one)",
-    )
+    add_arbitrator(p)
+    add_repertoire(p, REPERTOIRE_DEFAULT)
     p.add_argument(
         "--maze",
         default="all",
         metavar="NAME|all",
         help="one maze (name or file) or all of the arbitrator's mazes (default)",
     )
-    p.add_argument(
-        "--task",
-        metavar="FILE.yaml",
-        help="task settings (default: the ones recorded in the arbitrator)",
-    )
+    add_task(p, "the ones recorded in the arbitrator")
     p.add_argument(
         "--start",
         choices=("nominal", "random"),
         default="nominal",
         help="each maze's nominal start pose, or a random one from --seed",
     )
-    p.add_argument("--seed", type=count, default=0, metavar="N", help="seed of random starts")
+    add_seed(p, "seed of random starts")
     p.add_argument(
         "--episodes",
         type=at_least(1),
@@ -75,12 +75,7 @@ def add_parsers(sub) -> None:
         help="draw which repertoire cells were used (EvoRBC, paper Fig. 14)",
     )
     p.add_argument("--json", action="store_true", help="print the results as JSON")
-    p.add_argument(
-        "--allow-mismatch",
-        action="store_true",
-        help="use a repertoire (of the same robot) or sensor layout other than the one the "
-        "arbitrator was evolved with",
-    )
+    add_flag(p, "--allow-mismatch")
     p.set_defaults(func=cmd_replay)
 
 
@@ -123,7 +118,7 @@ def controller_inputs(arb: ArbitratorFile, arb_path: Path, args: argparse.Namesp
     from offline_evolution.maze_task.base import MazeTaskSettings
 
     repertoire, rep_path, warnings = None, None, []
-    if arb.kind == "evorbc":
+    if arb.kind.uses_repertoire:
         repertoire, rep_path, warnings = resolve_repertoire(
             arb, arb_path, args.repertoire, args.allow_mismatch
         )
@@ -188,7 +183,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
     check_outputs(written)
     check_distinct(written)
     arb = ArbitratorFile.load(arb_path)
-    if args.heatmap and arb.kind != "evorbc":
+    if args.heatmap and not arb.kind.uses_repertoire:
         raise CliError("--heatmap needs an EvoRBC arbitrator (standard NEAT has no primitives)")
     repertoire, rep_path, settings = controller_inputs(arb, arb_path, args)
     recorded = arb.evolution.get("task")
@@ -233,7 +228,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
             json.dumps(
                 {
                     "arbitrator": str(arb_path),
-                    "kind": arb.kind,
+                    "kind": arb.kind.name,
                     "robot": arb.robot,
                     "repertoire": rep_path,
                     "start": args.start,
@@ -247,7 +242,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
         )
     else:
         print(
-            f"{arb_path}: {arb.kind} controller for {arb.robot}"
+            f"{arb_path}: {arb.kind.name} controller for {arb.robot}"
             + (
                 f", {arb.mapping} mapping over {rep_path} ({len(repertoire)} primitives)"
                 if repertoire

@@ -25,6 +25,7 @@ from scipy.stats import mannwhitneyu
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.controller_kinds import EVORBC, KINDS, STANDARD, ControllerKind
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.registry import lookup
 from offline_evolution.arbitrator.evolve import (
@@ -38,22 +39,22 @@ from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
 from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
 
-METHODS = ("evorbc", "standard")
+METHODS = tuple(KINDS.values())
 
 #: Random starts per maze, and their seed, for the per-maze robustness table.
 ROBUST_EPISODES = 20
 ROBUST_SEED = 100
 
 
-def run_one(robot: str, kind: str, seed: int, generations: int, runs: Path) -> dict:
+def run_one(robot: str, kind: ControllerKind, seed: int, generations: int, runs: Path) -> dict:
     """One evolution run (or its saved result)."""
-    out = runs / f"{robot}-{kind}-seed{seed}.json"
+    out = runs / f"{robot}-{kind.name}-seed{seed}.json"
     if out.exists():
         return json.loads(out.read_text())["evolution"]
     run = load_run_settings(robot=robot)
     task_settings = MazeTaskSettings.load(run.task_path())
     repertoire = None
-    if kind == "evorbc":
+    if kind.uses_repertoire:
         rep_path = runs / f"{robot}-repertoire-seed{seed}.json"
         if rep_path.exists():
             repertoire = Repertoire.load(rep_path)
@@ -71,7 +72,7 @@ def run_one(robot: str, kind: str, seed: int, generations: int, runs: Path) -> d
         neat_file=str(neat_file),
         neat_sha256=file_sha256(neat_file),
         task=task_settings.as_dict(),
-        mapping=run.mapping if kind == "evorbc" else None,
+        mapping=run.mapping if kind.uses_repertoire else None,
         repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
         **run.selection(),
     )
@@ -90,7 +91,7 @@ def run_one(robot: str, kind: str, seed: int, generations: int, runs: Path) -> d
         str(runs / f"{robot}-repertoire-seed{seed}.json") if repertoire else None,
     ).save(out)
     print(
-        f"{robot} {kind} seed {seed}: best fitness {result.best_fitness:.3f}, reached "
+        f"{robot} {kind.name} seed {seed}: best fitness {result.best_fitness:.3f}, reached "
         f"{result.best_reached}/{task.n_mazes}, post {result.post_evaluation.fitness:.3f}, "
         f"{(time.perf_counter() - start) / 60:.1f} min",
         flush=True,
@@ -103,7 +104,7 @@ def finished_seeds(robots, seeds, runs: Path) -> list[int]:
     return [
         s
         for s in seeds
-        if all((runs / f"{r}-{m}-seed{s}.json").exists() for r in robots for m in METHODS)
+        if all((runs / f"{r}-{m.name}-seed{s}.json").exists() for r in robots for m in METHODS)
     ]
 
 
@@ -124,25 +125,19 @@ def summarise(robots, seeds, generations, runs: Path, out: Path) -> str:
     for robot in robots:
         evo = {m: [run_one(robot, m, s, generations, runs) for s in seeds] for m in METHODS}
         best = {m: np.array([e["best_fitness"] for e in evo[m]]) for m in METHODS}
-        p = mannwhitneyu(best["evorbc"], best["standard"], alternative="two-sided").pvalue
+        p = mannwhitneyu(best[EVORBC], best[STANDARD], alternative="two-sided").pvalue
         for m in METHODS:
             n_mazes = len(evo[m][0]["task"]["mazes"])
             all_reached = sum(e["best_reached"] == n_mazes for e in evo[m])
             post_fit = np.mean([e["post_evaluation"]["fitness"] for e in evo[m]])
             post_reach = np.mean([e["post_evaluation"]["reached"] for e in evo[m]])
-            name = "EvoRBC" if m == "evorbc" else "standard NEAT"
             lines.append(
-                f"| {robot} | {name} | {best[m].mean():.3f} ± {best[m].std(ddof=1):.3f} | "
+                f"| {robot} | {m.label} | {best[m].mean():.3f} ± {best[m].std(ddof=1):.3f} | "
                 f"{all_reached} of {len(seeds)} | {post_fit:.3f} / {post_reach:.0%} | "
                 f"{p:.4f} |"
             )
         plot_fitness_comparison(
-            {
-                ("EvoRBC" if m == "evorbc" else "standard NEAT"): [
-                    [h["best"] for h in e["history"]] for e in evo[m]
-                ]
-                for m in METHODS
-            },
+            {m.label: [[h["best"] for h in e["history"]] for e in evo[m]] for m in METHODS},
             out / f"arbitrator-check-{robot}.png",
             title=f"{robot}: highest fitness so far",
         )
@@ -175,10 +170,10 @@ def per_maze_table(robots, seeds, runs: Path) -> list[str]:
             fitness = np.zeros((len(seeds), len(names)))
             reached = np.zeros_like(fitness)
             for i, seed in enumerate(seeds):
-                arb = ArbitratorFile.load(runs / f"{robot}-{kind}-seed{seed}.json")
+                arb = ArbitratorFile.load(runs / f"{robot}-{kind.name}-seed{seed}.json")
                 rep = (
                     Repertoire.load(runs / f"{robot}-repertoire-seed{seed}.json")
-                    if kind == "evorbc"
+                    if kind.uses_repertoire
                     else None
                 )
                 outcomes, _ = replay(arb, task, starts, rep)
@@ -189,9 +184,8 @@ def per_maze_table(robots, seeds, runs: Path) -> list[str]:
                     reached[i, k] = row["reached"] / row["episodes"]
             means = zip(fitness.mean(0), reached.mean(0), strict=True)
             cells = [f"{f:.2f} ({r:.0%})" for f, r in means]
-            name = "EvoRBC" if kind == "evorbc" else "standard NEAT"
             rows.append(
-                f"| {robot} | {name} | {' | '.join(cells)} | "
+                f"| {robot} | {kind.label} | {' | '.join(cells)} | "
                 f"{fitness.mean():.2f} ({reached.mean():.0%}) |"
             )
     return [

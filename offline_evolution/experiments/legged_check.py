@@ -41,6 +41,7 @@ import numpy as np
 from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.config import ConfigError, build_settings
+from evorbc_ros.controller_kinds import EVORBC, STANDARD
 from evorbc_ros.repertoire import Repertoire, RepertoireError
 from evorbc_ros.robots.registry import lookup
 from offline_evolution.arbitrator.settings import load_run_settings
@@ -107,11 +108,11 @@ def run_all(
     for seed in sorted(set(seeds) | set(standard_seeds)):
         path = out / f"evorbc-seed{seed}.json"
         if seed in seeds and not path.exists():
-            cli("arbitrator", "--repertoire", str(repertoire), "--seed", str(seed),
+            cli(EVORBC.command, "--repertoire", str(repertoire), "--seed", str(seed),
                 "--out", str(path), *common)  # fmt: skip
         path = out / f"standard-seed{seed}.json"
         if seed in standard_seeds and not path.exists():
-            cli("standard", "--robot", robot, *budget, "--seed", str(seed),
+            cli(STANDARD.command, "--robot", robot, *budget, "--seed", str(seed),
                 "--out", str(path), *common)  # fmt: skip
 
 
@@ -132,7 +133,7 @@ def replay_nominal(arbitrator: Path, repertoire: Path | None) -> dict:
     from offline_evolution.maze_task.task import MazeTaskSettings, make_task
 
     arb = ArbitratorFile.load(arbitrator)
-    rep = Repertoire.load(repertoire) if arb.kind == "evorbc" else None
+    rep = Repertoire.load(repertoire) if arb.kind.uses_repertoire else None
     settings = build_settings(MazeTaskSettings, arb.evolution["task"], f"{arbitrator}: task")
     task = make_task(settings, arb.robot, workers=1)
     try:
@@ -265,14 +266,14 @@ def summarise(
             f"| standard NEAT still running (its checkpoint) | {parts} | {paper['standard']} |"
         )
     sizes = {
-        kind: [network_size(out / f"{kind}-seed{k}.json") for k in ks]
-        for kind, ks in (("evorbc", seeds), ("standard", standard_seeds))
+        kind: [network_size(out / f"{kind.name}-seed{k}.json") for k in ks]
+        for kind, ks in ((EVORBC, seeds), (STANDARD, standard_seeds))
     }
     sizes = {kind: [s for s in v if s is not None] for kind, v in sizes.items()}
     if any(sizes.values()):
         parts = [
-            f"{name} {np.mean(sizes[kind]):.1f} ({len(sizes[kind])} run(s))"
-            for kind, name in (("evorbc", "EvoRBC"), ("standard", "standard NEAT"))
+            f"{kind.label} {np.mean(sizes[kind]):.1f} ({len(sizes[kind])} run(s))"
+            for kind in (EVORBC, STANDARD)
             if sizes[kind]
         ]
         lines.append(

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from evorbc_ros.config import ConfigError
+from evorbc_ros.controller_kinds import ControllerKind, controller_kind
 from evorbc_ros.network import NetworkSpec
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.primitive import ParameterSpec
@@ -94,13 +95,17 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
         return self.robot.gait.parameter_specs()
 
     def controller(
-        self, kind: str, repertoire: Repertoire | None = None, mapping: str | None = None
+        self,
+        kind: ControllerKind | str,
+        repertoire: Repertoire | None = None,
+        mapping: str | None = None,
     ) -> LeggedController:
         """An EvoRBC controller (repertoire and mapping) or a standard one."""
-        if kind == "evorbc":
+        kind = controller_kind(kind)
+        if kind.uses_repertoire:
             key = f"evorbc:{mapping}:{repertoire.fingerprint()}"
-            return LeggedController("evorbc", mapping, repertoire.genes, repertoire.behaviour, key)
-        return LeggedController("standard", key="standard")
+            return LeggedController(kind, mapping, repertoire.genes, repertoire.behaviour, key)
+        return LeggedController(kind, key=kind.name)
 
     def evaluate(
         self,

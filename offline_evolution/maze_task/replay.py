@@ -70,7 +70,7 @@ def replay(
         n = int(result.cycles[e])
         choice = result.choice[e, :n]
         switches = float(np.mean(choice[1:] != choice[:-1])) if n > 1 else 0.0
-        if arbitrator.kind == "evorbc":
+        if arbitrator.kind.uses_repertoire:
             stopped = int(np.sum(choice == NO_PRIMITIVE))
         else:  # a standard controller has no primitive index: its outputs tell
             stopped = int(np.sum(~np.all(np.isfinite(result.outputs[e, :n]), axis=1)))
@@ -82,7 +82,7 @@ def replay(
                 fitness=float(result.fitness[e]),
                 final_distance=float(result.final_distance[e]),
                 start=(float(row[1]), float(row[2]), float(row[3])),
-                switches_per_cycle=switches if arbitrator.kind == "evorbc" else 0.0,
+                switches_per_cycle=switches if arbitrator.kind.uses_repertoire else 0.0,
                 fell=bool(result.fell[e]) if result.fell is not None else False,
                 stopped_cycles=stopped,
             )

@@ -15,6 +15,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from evorbc_ros.controller_kinds import ControllerKind, controller_kind
 from evorbc_ros.mapping import MappingFunction, PrimitiveLookup
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.arbitrator.compiled import NetworkPack, pack_networks
@@ -234,10 +235,14 @@ class MazeTask(MazeTaskBase):
     # -- the task protocol (offline_evolution.task_protocol) -----------------------
 
     def controller(
-        self, kind: str, repertoire: Repertoire | None = None, mapping: str | None = None
+        self,
+        kind: ControllerKind | str,
+        repertoire: Repertoire | None = None,
+        mapping: str | None = None,
     ) -> ControllerArrays:
         """An EvoRBC controller (repertoire and mapping) or a standard one."""
-        if kind == "evorbc":
+        kind = controller_kind(kind)
+        if kind.uses_repertoire:
             return evorbc_controller(repertoire, mapping, self.robot)
         return standard_controller(self.robot)
 

@@ -446,19 +446,13 @@ def generate_maze(
     raise RuntimeError(f"no solvable maze for {spec.robot} in {MAX_TRIES} draws (seed {seed})")
 
 
-def prove(maze: Maze, spec: MazeSpec) -> tuple[float, float] | None:
-    """``(longest path m, narrowest gap m)`` if ``maze`` is solvable for ``spec``, else None.
+def _proof(maze: Maze, spec: MazeSpec) -> tuple[float, float, Field] | None:
+    """``(longest path m, narrowest gap m, path field)`` if ``maze`` is solvable, else None.
 
     Solvable: every start cell that clears the robot reaches the target keeping
     ``spec.margin`` from the walls, within ``spec.path_limit``, and the widest route's
     narrowest gap is at least the design's narrowest less two grid cells.
     """
-    proof = _proof(maze, spec)
-    return None if proof is None else proof[:2]
-
-
-def _proof(maze: Maze, spec: MazeSpec) -> tuple[float, float, Field] | None:
-    """:func:`prove`'s figures and the path field it searched, or None."""
     field_ = solve(maze, spec.cell, spec.margin, spec.snap)
     if stranded_starts(maze, field_, spec.robot_radius):
         return None

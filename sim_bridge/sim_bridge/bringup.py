@@ -32,8 +32,9 @@ from evorbc_ros.defaults import (
 from evorbc_ros.nodes.common import StartupError
 from evorbc_ros.repertoire import RepertoireError
 from evorbc_ros.robots import registry
-from evorbc_ros.robots.registry import DEFAULT_ROBOT, ROBOT_NAMES
+from evorbc_ros.robots.registry import DEFAULT_ROBOT
 from sim_bridge.bridge_node import SimBridgeNode, episode_verdict
+from sim_bridge.cli_options import add_arbitrator, add_flag, add_repertoire, add_robot, add_seed
 from sim_bridge.cli_support import OneLineParser, check_output_file, integer_in, report_unexpected
 from sim_bridge.graph import NodeSpec, exit_ends_graph, shipped_arbitrator, sim_graph
 from sim_bridge.maze import Maze, load_named_maze, maze_names
@@ -52,11 +53,9 @@ def parse_args(argv=None) -> argparse.Namespace:
         description="Run an evolved controller through the ROS 2 graph "
         "against the PyBullet simulation bridge, one maze episode.",
     )
-    p.add_argument(
-        "--robot",
-        choices=ROBOT_NAMES,
-        default="",
-        help="robot whose shipped controller runs (default: the arbitrator file's, else 4ws-5; "
+    add_robot(
+        p,
+        "robot whose shipped controller runs (default: the arbitrator file's, else 4ws-5; "
         f"{', '.join(shipped_robots())} ship one)",
     )
     p.add_argument(
@@ -65,20 +64,9 @@ def parse_args(argv=None) -> argparse.Namespace:
         help=f"maze name ({', '.join(maze_names())}) or file "
         "(default: the robot's own: obstacle for the 4WS robots)",
     )
-    p.add_argument(
-        "--arbitrator", default="", help="arbitrator file (default: the shipped one for --robot)"
-    )
-    p.add_argument(
-        "--paper",
-        action="store_true",
-        help="run the paper-protocol controller shipped for --robot (trained on the paper's "
-        "mazes only) instead of its default one; not with --arbitrator",
-    )
-    p.add_argument(
-        "--repertoire",
-        default="",
-        help="its repertoire (default: the shipped one for the arbitrator's robot)",
-    )
+    add_arbitrator(p, "the shipped one for --robot")
+    add_flag(p, "--paper")
+    add_repertoire(p, "the shipped one for the arbitrator's robot")
     p.add_argument(
         "--mode",
         choices=("lockstep", "realtime"),
@@ -86,7 +74,7 @@ def parse_args(argv=None) -> argparse.Namespace:
         help="lockstep: deterministic and fast (default); realtime: 10 Hz wall clock",
     )
     p.add_argument("--start", default="nominal", help="nominal, random or 'x,y,heading_deg'")
-    p.add_argument("--seed", type=integer_in(0), default=0, help="seed of a random start")
+    add_seed(p, "seed of a random start")
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--plot", default="", help="trajectory picture (default: <maze>-run.png)")
     p.add_argument("--result", default="", help="also keep the result as JSON here")
@@ -182,7 +170,7 @@ def start_graph(
         mode=args.mode,
         gui=args.gui,
         arbitrator=arb_path,
-        repertoire=args.repertoire,
+        repertoire=args.repertoire or "",  # empty: the shipped one
         start=args.start,
         seed=args.seed,
         result_file=result_file,
@@ -303,7 +291,7 @@ def run(args: argparse.Namespace) -> int:
             bridge = start_graph(graph, args, arb.robot, arb_path, result_file)
             if not args.quiet:
                 print(
-                    f"evorbc-sim: {arb.kind} controller {arb_path} in maze {maze.name} "
+                    f"evorbc-sim: {arb.kind.name} controller {arb_path} in maze {maze.name} "
                     f"({args.mode}), ROS_DOMAIN_ID={env.get('ROS_DOMAIN_ID', '0')}",
                     file=sys.stderr,
                 )

@@ -99,7 +99,7 @@ class ArbitratorNode(ManagedNode):
         for t in self.groups.sizes:
             self.subscription(Float64MultiArray, t, lambda msg, t=t: self.on_input(t, msg))
         self.get_logger().info(
-            f"{spec.kind} controller for {spec.robot} from {self.controller.arbitrator_path}"
+            f"{spec.kind.name} controller for {spec.robot} from {self.controller.arbitrator_path}"
             + (
                 f" over {self.controller.repertoire_path} "
                 f"({len(self.controller.repertoire)} primitives)"

@@ -139,11 +139,6 @@ class HexapodGeometry:
         """m, height of the body centre above the ground in the neutral pose (B = 0)."""
         return self.tibia_length + self.foot_radius
 
-    def joint_limits(self) -> np.ndarray:
-        """``(18,)`` rad, the largest |target| of each joint (C: its upper bound, pi)."""
-        per_leg = [self.coxa_limit, self.femur_limit, math.pi]
-        return np.array(per_leg * 6)
-
     def joint_torques(self) -> np.ndarray:
         """``(18,)`` N m, the torque limit of each joint."""
         return np.array([self.coxa_torque, self.femur_torque, self.tibia_torque] * 6)
@@ -202,11 +197,6 @@ class GaitTable(LeggedGaitTable):
     def __init__(self, genes: np.ndarray, geometry: HexapodGeometry | None = None):
         self.geometry = geometry or HexapodGeometry()
         super().__init__(genes, hexapod_gait(self.geometry), HEXAPOD)
-
-
-def full_pose(evolved: np.ndarray) -> np.ndarray:
-    """``(m, 18)`` joint targets from ``(m, 12)`` A/B targets: each shin kept vertical."""
-    return hexapod_gait().drive(evolved)
 
 
 def mirror_genes(genes: np.ndarray) -> np.ndarray:

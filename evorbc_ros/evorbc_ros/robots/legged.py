@@ -30,11 +30,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from evorbc_ros.config import ConfigError, load_yaml_mapping
+from evorbc_ros.config import ConfigError
 from evorbc_ros.robots.primitive import ParameterSpec
 
 #: Smoothness rho of eq. 10: pi/8 (close to a sine) to pi/8 + 2 pi (close to a square).
@@ -319,8 +318,3 @@ def gait_from_settings(data: dict, source: str) -> Gait:
     if frequency <= 0.0:
         raise ConfigError(f"{source}: gait.frequency_hz: expected > 0, got {frequency:g}")
     return Gait(oscillators, joints, frequency)
-
-
-def load_gait(path: str | Path) -> Gait:
-    """The gait of the legged robot described by settings file ``path``."""
-    return gait_from_settings(load_yaml_mapping(path), str(path))

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from evorbc_ros.controller_kinds import ControllerKind, controller_kind, direct_genes
 from evorbc_ros.goal import GoalInputs, yaw_from_quaternion
 from evorbc_ros.laser import LaserToRangefinders
 from evorbc_ros.mapping import NO_PRIMITIVE, MappingFunction, PrimitiveLookup, choose_primitive
@@ -53,11 +54,14 @@ from sim_bridge.maze_sims import MazeSims
 class LeggedController:
     """How network outputs become a primitive (picklable, sent to the workers)."""
 
-    kind: str  # "evorbc" or "standard"
+    kind: ControllerKind  # may be given by name
     mapping: str | None = None
     genes: np.ndarray | None = None  # (n, 1 + 3 k) repertoire genes (EvoRBC)
     behaviour: np.ndarray | None = None  # (n, 2) m, repertoire behaviours (EvoRBC)
     key: str = ""  # identifies the controller, so workers build its lookup grid once
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "kind", controller_kind(self.kind))
 
 
 @dataclass(frozen=True)
@@ -79,7 +83,7 @@ class _Chooser:
 
     def __init__(self, controller: LeggedController, settings: LeggedRobotSettings):
         self.kind = controller.kind
-        if self.kind == "evorbc":
+        if self.kind.uses_repertoire:
             self.genes = np.asarray(controller.genes, dtype=np.float64)
             self.table = LeggedGaitTable(self.genes, settings.gait, settings.name)
             self.mapping = MappingFunction.for_behaviours(controller.mapping, controller.behaviour)
@@ -91,14 +95,14 @@ class _Chooser:
 
         No table (None) when the outputs are not finite: no primitive runs this cycle.
         """
-        if self.kind == "evorbc":
+        if self.kind.uses_repertoire:
             index = choose_primitive(self.mapping, self.lookup, out[0], out[1])[0]
             if index == NO_PRIMITIVE:
                 return index, None, np.array([0])
             return index, self.table, np.array([index])
-        if not np.all(np.isfinite(out)):
+        genes = direct_genes(out)
+        if genes is None:
             return NO_PRIMITIVE, None, np.array([0])
-        genes = 2.0 * np.clip(out, 0.0, 1.0) - 1.0
         s = self.settings
         return -1, LeggedGaitTable(genes, s.gait, s.name), np.array([0])
 

@@ -357,11 +357,6 @@ class LeggedSim:
             np.array([s[3] for s in states]),
         )
 
-    def foot_positions(self) -> np.ndarray:
-        """``(feet, 3)`` world positions (m) of the foot links' frames."""
-        states = p.getLinkStates(self.robot, self.feet, physicsClientId=self.client)
-        return np.array([s[4] for s in states]).reshape(-1, 3)
-
     def reach_radius(self) -> float:
         """Radius (m) about the body centre holding every collision shape's bounding box.
 

@@ -6,18 +6,12 @@ import functools
 
 import numpy as np
 
-from evorbc_ros.config import config_dir
 from evorbc_ros.robots.primitive import ParameterSpec
 from sim_bridge.legged.evaluate import HEADING, PATH, TILT, X, Y
 from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.legged.pool import EvaluationPool
 from sim_bridge.legged.settings import LeggedRobotSettings, load_robot_settings
 from sim_bridge.robots.base import PrimitiveOutcome, control_steps
-
-
-def robot_settings_file(name: str):
-    """The shipped settings file of robot ``name`` (``config/robots/NAME.yaml``)."""
-    return config_dir() / "robots" / f"{name}.yaml"
 
 
 class LeggedRobot:
