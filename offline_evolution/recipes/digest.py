@@ -64,7 +64,8 @@ class Verdict:
     """How an output compares with the shipped file a recipe step states."""
 
     reproduced: bool  # the shipped file, but perhaps for its wall-clock times
-    known: bool  # the file the recipe is known to make (reproduced, or its stated other)
+    known: bool  # what the step states it makes (the shipped file, its stated other, or
+    # anything when it states nothing)
     text: str  # one line for the user
 
     @staticmethod
@@ -88,7 +89,7 @@ class Verdict:
                 f"step's note; content {got_content})",
             )
         if sha256 is None and content is None:
-            return Verdict(False, False, f"no shipped file stated (sha256 {got})")
+            return Verdict(False, True, f"no shipped file stated (sha256 {got})")
         return Verdict(
             False,
             False,
