@@ -184,3 +184,39 @@ def test_the_verdict_sets_wall_clock_times_aside(tmp_path):
     rerun.write_text(json.dumps(data))
     verdict = Verdict.of(rerun, sha, content, None)
     assert not verdict.reproduced and not verdict.known and "NOT reproduced" in verdict.text
+
+
+def _arbitrator_steps():
+    for path in RECIPES:
+        recipe = load_recipe(path)
+        for step in recipe.steps:
+            if step.run == "arbitrator":
+                yield pytest.param(recipe, step, id=f"{path.stem}-{step.step}")
+
+
+@pytest.mark.parametrize(("recipe", "step"), list(_arbitrator_steps()))
+def test_each_arbitrator_step_is_what_the_shipped_file_records(recipe, step):
+    """Seed, length, task, NEAT file, selection and input names: the recipe's settings
+    are the shipped run's (a setting edited since would fail here, not hours later)."""
+    from offline_evolution.arbitrator.evolve import file_sha256 as neat_sha256
+    from offline_evolution.arbitrator.settings import load_run_settings
+    from offline_evolution.maze_task.task import MazeTaskSettings
+
+    shipped = {file_sha256(p): p for p in SHIPPED.glob("*.json")}
+    arb = ArbitratorFile.load(shipped[step.sha256])
+    run = load_run_settings(step.settings)
+    evolution = arb.evolution
+    assert evolution["seed"] == step.seed
+    assert evolution["generations"] == (step.generations or run.generations)
+    assert evolution["task"] == MazeTaskSettings.load(step.task or run.task_path()).as_dict()
+    assert evolution["neat_sha256"] == neat_sha256(step.neat or run.neat_path())
+    assert arb.mapping == run.mapping
+    post = evolution["post_evaluation"]
+    # A file shipped before these were recorded was made with their defaults.
+    recorded = (post.get("rule", "mean"), post.get("hall_of_fame", 25))
+    assert recorded == (run.post_rule, run.hall_of_fame)
+    assert arb.repertoire["file"] == recipe.step(step.repertoire).out
+    if step.init_from:
+        assert evolution["initial_network"]["file"] == recipe.step(step.init_from).out
+    else:
+        assert "initial_network" not in evolution

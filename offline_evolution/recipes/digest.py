@@ -69,8 +69,18 @@ class Verdict:
     text: str  # one line for the user
 
     @staticmethod
-    def of(path, sha256: str | None, content: str | None, recipe_content: str | None):
-        """Compare the output ``path`` with the hashes a step states."""
+    def of(
+        path,
+        sha256: str | None,
+        content: str | None,
+        recipe_content: str | None,
+        shipped: str | None = None,
+    ):
+        """Compare the output ``path`` with the hashes a step states.
+
+        ``shipped``, the shipped file itself if at hand, lets a file that is not it say
+        where it differs.
+        """
         got, got_content = file_sha256(path), content_sha256(path)
         if sha256 is not None and got == sha256:
             return Verdict(True, True, f"reproduced: the shipped file, byte for byte ({got})")
@@ -90,8 +100,41 @@ class Verdict:
             )
         if sha256 is None and content is None:
             return Verdict(False, True, f"no shipped file stated (sha256 {got})")
+        where = ""
+        if shipped is not None and os.path.isfile(shipped):
+            where = "; differs from the shipped file in " + differences(path, shipped)
         return Verdict(
             False,
             False,
-            f"NOT reproduced: content {got_content}, expected {content or sha256}",
+            f"NOT reproduced: content {got_content}, expected {content or sha256}{where}",
         )
+
+
+def differences(path: str | os.PathLike, shipped: str | os.PathLike, most: int = 6) -> str:
+    """Where the JSON of ``path`` differs from ``shipped``'s, wall-clock times aside.
+
+    A text listing at most ``most`` key paths (``evolution.post_evaluation.rule (not in
+    the shipped file)``) and how many more there are.
+    """
+    found: list[str] = []
+
+    def walk(a, b, where: str) -> None:
+        if isinstance(a, dict) and isinstance(b, dict):
+            for key in sorted(set(a) | set(b), key=str):
+                at = f"{where}.{key}" if where else str(key)
+                if key not in b:
+                    found.append(f"{at} (not in the shipped file)")
+                elif key not in a:
+                    found.append(f"{at} (only in the shipped file)")
+                else:
+                    walk(a[key], b[key], at)
+        elif isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+            for i, (x, y) in enumerate(zip(a, b, strict=True)):
+                walk(x, y, f"{where}[{i}]")
+        elif a != b:
+            found.append(where or "the whole file")
+
+    load = lambda p: without_wall_clock(load_json_file(p, "output", ConfigError))  # noqa: E731
+    walk(load(path), load(shipped), "")
+    more = f" and {len(found) - most} more" if len(found) > most else ""
+    return (", ".join(found[:most]) or "nothing") + more

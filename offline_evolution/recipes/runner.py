@@ -85,7 +85,7 @@ def run_recipe(
         verdict = None
         if budget == "full":
             verdict = Verdict.of(
-                target, step.sha256, step.content_sha256, step.recipe_content_sha256
+                target, step.sha256, step.content_sha256, step.recipe_content_sha256, step.shipped
             )
             say(f"[{i}/{len(recipe.steps)}] {step.step}: {verdict.text}")
         outcomes.append(StepOutcome(step.step, target, ran, verdict))

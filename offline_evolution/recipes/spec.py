@@ -51,6 +51,9 @@ class _Common:
         None, doc="content_sha256 this recipe makes, where it is not the shipped file's"
     )
     note: str = setting("", doc="why the recipe makes another file than the shipped one")
+    shipped: str | None = setting(
+        None, doc="the shipped file, so that a full run that differs says where"
+    )
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -168,7 +171,7 @@ def _resolved(step: Step, label: str, folder: Path, earlier: list[Step]) -> Step
     """``step`` with its file keys made absolute and its step references checked."""
     names = [s.step for s in earlier]
     files = {}
-    for key in ("settings", "neat", "task", "repertoire_file", "init_from_file"):
+    for key in ("settings", "neat", "task", "repertoire_file", "init_from_file", "shipped"):
         value = getattr(step, key, None)
         if value is None:
             continue
