@@ -101,7 +101,7 @@ def _claim(out: Path, recipe: Recipe, budget: str) -> None:
             held = json.loads(path.read_text())
         except (OSError, ValueError) as e:
             raise ConfigError(f"{path}: cannot read it ({e}); choose another --out") from None
-        if held != state:
+        if _what_runs(held) != _what_runs(state):
             what = held.get("recipe", {}).get("recipe") if isinstance(held, dict) else None
             was = f"{what!r} at the {held.get('budget')} budget" if what else "another run"
             raise ConfigError(
@@ -109,6 +109,22 @@ def _claim(out: Path, recipe: Recipe, budget: str) -> None:
             )
         return
     atomic_write_text(path, json.dumps(state, indent=1) + "\n")
+
+
+#: Step keys that only state what the shipped file is: editing them changes no output.
+VERDICT_KEYS = ("sha256", "content_sha256", "recipe_content_sha256", "note", "shipped")
+
+
+def _what_runs(state) -> object:
+    """A folder's recorded state without :data:`VERDICT_KEYS` (what decides its files)."""
+    try:
+        steps = [
+            {k: v for k, v in step.items() if k not in VERDICT_KEYS}
+            for step in state["recipe"]["steps"]
+        ]
+        return {**state, "recipe": {**state["recipe"], "steps": steps}}
+    except (KeyError, TypeError, AttributeError):
+        return state
 
 
 def _finished(step, target: Path) -> bool:
