@@ -8,6 +8,7 @@ Subcommands:
     replay       run a controller in the mazes and report
     mazes        generate seeded, proven-solvable mazes for a robot
     evaluate     run a controller on a suite of mazes from many starts, perturbed or not
+    recipe       make a shipped controller from its recipe (config/recipes/*.yaml)
 
 Bad arguments or files end the program with a one-line message and a non-zero status,
 never a traceback (set ``EVORBC_DEBUG=1`` to see one for an unexpected failure).
@@ -24,7 +25,7 @@ from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.config import ConfigError
 from evorbc_ros.repertoire import RepertoireError
 from offline_evolution.checkpoint import CheckpointError
-from offline_evolution.commands import arbitrator, evaluate, mazes, repertoire, replay
+from offline_evolution.commands import arbitrator, evaluate, mazes, recipe, repertoire, replay
 from offline_evolution.commands.common import EXIT_ERROR, EXIT_INTERRUPTED, CliError
 from sim_bridge.cli_support import OneLineParser, report_unexpected
 from sim_bridge.cluster_pool import CLUSTER_VARIABLE, ClusterError
@@ -43,6 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
     replay.add_parsers(sub)
     mazes.add_parsers(sub)
     evaluate.add_parsers(sub)
+    recipe.add_parsers(sub)
     return parser
 
 

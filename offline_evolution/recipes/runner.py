@@ -1,0 +1,198 @@
+"""Running a recipe: each step in order, in this process, resumable, then the verdicts.
+
+A step runs the code of the ``evorbc-evolve`` subcommand it stands for (``repertoire``,
+``arbitrator``), called in this process with the options the recipe gives, so it makes
+what that command makes: the same checks before any work, the same checkpoints, locks and
+atomic writes, the same progress lines. Its output and checkpoint are the command's
+defaults in the output folder (``OUT/<out>`` and ``OUT/<out>.checkpoint.*``), so:
+
+* a step whose output exists and whose checkpoint does not is finished and is skipped (a
+  command writes its output atomically, then deletes its checkpoint);
+* an interrupted step resumes from its checkpoint when the recipe is run again.
+
+The output folder records the recipe and budget it holds (``recipe-run.json``); a run of
+another recipe or budget is refused there, so a small run's files never pass for a full
+run's.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from evorbc_ros.atomic_io import atomic_path, atomic_write_text
+from evorbc_ros.config import ConfigError
+from offline_evolution.recipes import budget as budgets
+from offline_evolution.recipes.digest import Verdict
+from offline_evolution.recipes.spec import ArbitratorStep, CopyStep, Recipe, RepertoireStep
+
+#: The file in an output folder that says which recipe and budget it holds.
+STATE_FILE = "recipe-run.json"
+#: Checkpoint suffix of each kind of step (the subcommands' defaults).
+CHECKPOINT_SUFFIX = {"repertoire": ".checkpoint.npz", "arbitrator": ".checkpoint.json"}
+
+
+@dataclass(frozen=True)
+class StepOutcome:
+    """What became of one step: its output and, at the full budget, its verdict."""
+
+    step: str
+    out: Path
+    ran: bool  # False: found finished and skipped
+    verdict: Verdict | None
+
+
+def run_recipe(
+    recipe: Recipe,
+    out: Path,
+    budget: str = "full",
+    workers: int | None = None,
+    quiet: bool = False,
+    say: Callable[[str], None] | None = None,
+) -> list[StepOutcome]:
+    """Run every step of ``recipe`` into the folder ``out`` at ``budget``.
+
+    Args:
+        out: the output folder (created); a rerun resumes what is there.
+        budget: ``full`` or ``small`` (:mod:`.budget`).
+        workers: processes for PyBullet simulations (results do not depend on it).
+        quiet: no per-generation or per-batch lines from the steps.
+        say: where the recipe's own lines go (default: stderr).
+
+    Raises:
+        CliError: a step failed or was interrupted (its message says how to resume).
+        ConfigError: ``out`` holds another recipe's or budget's run.
+    """
+    say = say or (lambda line: print(line, file=sys.stderr))
+    out.mkdir(parents=True, exist_ok=True)
+    _claim(out, recipe, budget)
+    outcomes = []
+    for i, step in enumerate(recipe.steps, 1):
+        target = out / step.out
+        head = f"[{i}/{len(recipe.steps)}] {step.step} ({step.run}) -> {target}"
+        if _finished(step, target):
+            say(f"{head}: done before, skipped")
+            ran = False
+        else:
+            say(f"{head}: running")
+            _run_step(recipe, step, out, budget, workers, quiet)
+            ran = True
+        verdict = None
+        if budget == "full":
+            verdict = Verdict.of(
+                target, step.sha256, step.content_sha256, step.recipe_content_sha256, step.shipped
+            )
+            say(f"[{i}/{len(recipe.steps)}] {step.step}: {verdict.text}")
+        outcomes.append(StepOutcome(step.step, target, ran, verdict))
+    return outcomes
+
+
+def _claim(out: Path, recipe: Recipe, budget: str) -> None:
+    """Record in ``out`` the recipe and budget it holds; refuse another's folder."""
+    state = {"recipe": recipe.as_dict(), "budget": budget}
+    path = out / STATE_FILE
+    if path.exists():
+        try:
+            held = json.loads(path.read_text())
+        except (OSError, ValueError) as e:
+            raise ConfigError(f"{path}: cannot read it ({e}); choose another --out") from None
+        if _what_runs(held) != _what_runs(state):
+            what = held.get("recipe", {}).get("recipe") if isinstance(held, dict) else None
+            was = f"{what!r} at the {held.get('budget')} budget" if what else "another run"
+            raise ConfigError(
+                f"{out} holds {was}, not this recipe at the {budget} budget; choose another --out"
+            )
+        return
+    atomic_write_text(path, json.dumps(state, indent=1) + "\n")
+
+
+#: Step keys that only state what the shipped file is: editing them changes no output.
+VERDICT_KEYS = ("sha256", "content_sha256", "recipe_content_sha256", "note", "shipped")
+
+
+def _what_runs(state) -> object:
+    """A folder's recorded state without :data:`VERDICT_KEYS` (what decides its files)."""
+    try:
+        steps = [
+            {k: v for k, v in step.items() if k not in VERDICT_KEYS}
+            for step in state["recipe"]["steps"]
+        ]
+        return {**state, "recipe": {**state["recipe"], "steps": steps}}
+    except (KeyError, TypeError, AttributeError):
+        return state
+
+
+def _finished(step, target: Path) -> bool:
+    """Whether the step wrote its output and left no checkpoint to resume."""
+    suffix = CHECKPOINT_SUFFIX.get(step.run)
+    checkpoint = target.with_name(target.name + suffix) if suffix else None
+    return target.is_file() and not (checkpoint and checkpoint.exists())
+
+
+def _run_step(recipe: Recipe, step, out: Path, budget: str, workers, quiet: bool) -> None:
+    target = out / step.out
+    if isinstance(step, CopyStep):
+        source = out / recipe.step(step.source).out
+        with atomic_path(target) as tmp:
+            shutil.copyfile(source, tmp)
+        return
+    if isinstance(step, RepertoireStep):
+        argv = _repertoire_argv(step, budget)
+    elif isinstance(step, ArbitratorStep):
+        argv = _arbitrator_argv(recipe, step, out, budget)
+    else:  # pragma: no cover - the loader knows no other kind
+        raise ConfigError(f"{recipe.path}: step {step.step}: unknown kind {step.run!r}")
+    argv += ["--out", str(target)]
+    if workers:
+        argv += ["--workers", str(workers)]
+    if quiet:
+        argv.append("--quiet")
+    _command(argv)
+
+
+def _repertoire_argv(step: RepertoireStep, budget: str) -> list[str]:
+    argv = ["repertoire", "--robot", step.robot, "--config", step.settings]
+    argv += ["--seed", str(step.seed)]
+    if step.iterations is not None:
+        argv += ["--iterations", str(step.iterations)]
+    if budget == "small":
+        argv += budgets.repertoire_options()  # the last --iterations given wins
+    return argv
+
+
+def _arbitrator_argv(recipe: Recipe, step: ArbitratorStep, out: Path, budget: str) -> list[str]:
+    repertoire = step.repertoire_file or str(out / recipe.step(step.repertoire).out)
+    argv = ["arbitrator", "--repertoire", repertoire, "--seed", str(step.seed)]
+    files = {"--config": step.settings, "--neat-config": step.neat, "--task": step.task}
+    if budget == "small":
+        folder = out / "small-settings" / step.step
+        files = budgets.small_arbitrator_files(step.settings, step.neat, step.task, folder)
+        argv += ["--generations", str(budgets.SMALL_GENERATIONS)]
+    elif step.generations is not None:
+        argv += ["--generations", str(step.generations)]
+    for option, path in files.items():
+        if path is not None:
+            argv += [option, str(path)]
+    init = step.init_from_file or (
+        str(out / recipe.step(step.init_from).out) if step.init_from else None
+    )
+    if init is not None:
+        argv += ["--init-from", init]
+    return argv
+
+
+def _command(argv: list[str]) -> None:
+    """Run the ``evorbc-evolve`` subcommand ``argv`` in this process.
+
+    The subcommand's own parser builds its options (defaults included) and its function
+    runs them, exactly as the command line would.
+    """
+    from offline_evolution.cli import build_parser
+
+    args: argparse.Namespace = build_parser().parse_args(argv)
+    args.func(args)
