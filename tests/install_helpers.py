@@ -21,6 +21,7 @@ import pytest
 import rclpy
 from rclpy.context import Context
 from rclpy.node import Node
+from ros_domains import claim_domain
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -48,7 +49,7 @@ def clean_env(domain: int, **extra: str) -> dict:
         and not k.startswith("COLCON")
     }
     env.update(
-        ROS_DOMAIN_ID=str(domain),
+        ROS_DOMAIN_ID=str(claim_domain(domain)),  # ours alone (tests/ros_domains.py)
         ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
         PYTHONUNBUFFERED="1",
         **extra,
@@ -84,7 +85,7 @@ def assert_fatal_line(done: subprocess.CompletedProcess, node: str, start: str) 
 def wait_for_node(name: str, domain: int, process: subprocess.Popen, timeout=60.0) -> None:
     """Wait until a node called ``name`` shows in the ROS graph of ``domain``."""
     context = Context()
-    rclpy.init(context=context, domain_id=domain)
+    rclpy.init(context=context, domain_id=claim_domain(domain))
     try:
         probe = Node("install_probe", context=context)
         deadline = time.monotonic() + timeout

@@ -20,6 +20,7 @@ SPARES = tuple(range(210, 220))
 WAIT = 900.0
 
 _held: dict[int, int] = {}  # domain -> open lock file descriptor
+_given: dict[int, int] = {}  # preferred domain -> the one claimed for it, until released
 
 
 def _lock_path(domain: int) -> Path:
@@ -48,10 +49,15 @@ def claim_domain(preferred: int) -> int:
     Raises:
         TimeoutError: every candidate stayed busy for :data:`WAIT` s.
     """
+    if preferred in _given:  # asked again by the same test: the same domain
+        return _given[preferred]
     deadline = time.monotonic() + WAIT
     while True:
         for domain in (preferred, *SPARES):
+            if domain in _held and domain != preferred:
+                continue  # a spare this process already gave to another preferred domain
             if _try(domain):
+                _given[preferred] = domain
                 return domain
         if time.monotonic() > deadline:
             raise TimeoutError(f"ROS domains {preferred} and {SPARES} stayed busy")
@@ -63,3 +69,4 @@ def release_all() -> None:
     for fd in _held.values():
         os.close(fd)  # closing the descriptor drops the flock
     _held.clear()
+    _given.clear()

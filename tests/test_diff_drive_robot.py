@@ -15,6 +15,7 @@ import textwrap
 
 import numpy as np
 import pytest
+from ros_domains import claim_domain
 
 from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.robots import registry
@@ -286,8 +287,8 @@ def test_a_user_robot_file_drives_the_lockstep_graph_exactly_as_offline(pipeline
     outcomes, result = replay(arb, task, task.nominal_starts(), rep)
     cli(
         pipeline, "evorbc-sim", "--arbitrator", "a.json", "--repertoire", "r.json",
-        "--result", "run.json", "--plot", "run.png", "--quiet", "--domain-id", "178",
-        "--bag", "bag",
+        "--result", "run.json", "--plot", "run.png", "--quiet",
+        "--domain-id", str(claim_domain(178)), "--bag", "bag",
     )  # fmt: skip
     got = json.loads((run / "run.json").read_text())
     assert got["robot"] == "burger-test" and got["episode_time"] == 15.0

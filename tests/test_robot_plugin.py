@@ -14,6 +14,7 @@ import sys
 import numpy as np
 import pytest
 from plugin_helpers import MODULE, build_plugin
+from ros_domains import claim_domain
 
 from evorbc_ros.robots import registry
 
@@ -91,7 +92,8 @@ def test_a_robot_in_its_own_package_goes_through_the_whole_pipeline(tmp_path, pl
     # from the registration; every node finds the robot through the plugin.
     cli(
         tmp_path, "evorbc-sim", "--arbitrator", "a.json", "--repertoire", "r.json",
-        "--result", "run.json", "--plot", "run.png", "--quiet", "--domain-id", "177",
+        "--result", "run.json", "--plot", "run.png", "--quiet",
+        "--domain-id", str(claim_domain(177)),
     )  # fmt: skip
     got = json.loads((tmp_path / "run.json").read_text())
     assert got["robot"] == "crab" and got["episode_time"] == 15.0

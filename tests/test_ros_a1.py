@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from a1_helpers import a1_settings, trot_repertoire
 from graph_helpers import assert_lockstep_reproduces, switching_arbitrator
+from ros_domains import claim_domain
 from trajectory_msgs.msg import JointTrajectory
 
 from evorbc_ros.nodes.common import vector_message
@@ -76,7 +77,7 @@ def test_evorbc_sim_runs_the_a1(tmp_path, controller, capsys):
     argv = ["--robot", "a1", "--arbitrator", str(arb_path), "--repertoire", str(rep_path)]
     picture = tmp_path / "run.png"  # not <maze>-run.png in the working directory
     argv += ["--start=3.3,-0.45,0", "--result", str(result), "--plot", str(picture), "--quiet"]
-    assert main([*argv, "--domain-id", "172"]) == 0
+    assert main([*argv, "--domain-id", str(claim_domain(172))]) == 0
     assert picture.is_file()
     got = json.loads(result.read_text())
     assert got["robot"] == "a1" and got["maze"] == "a1" and got["reached"]

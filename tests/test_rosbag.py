@@ -17,6 +17,7 @@ from install_helpers import assert_fatal_line
 from mcap.reader import make_reader
 from nav_msgs.msg import Odometry
 from rclpy.serialization import serialize_message
+from ros_domains import claim_domain
 from rosbags.rosbag2 import Reader
 
 from sim_bridge import player
@@ -435,7 +436,8 @@ def recorded(tmp_path_factory):
     bag, result = tmp / "gaps-run", tmp / "result.json"
     done = subprocess.run(
         [sys.executable, "-P", "-m", "sim_bridge.bringup", "--maze", "gaps", "--bag", str(bag),
-         "--result", str(result), "--plot", str(tmp / "run.png"), "--domain-id", str(RECORD)],
+         "--result", str(result), "--plot", str(tmp / "run.png"),
+         "--domain-id", str(claim_domain(RECORD))],
         env=graph_env(RECORD), capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     return bag, json.loads(result.read_text()), done.returncode, done.stdout + done.stderr

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
+from ros_domains import claim_domain
 
 
 def children(pid: int) -> list[int]:
@@ -38,7 +39,7 @@ def cmdline(pid: int) -> str:
 def test_evorbc_sim_exits_1_naming_a_node_that_died(tmp_path):
     env = dict(os.environ, PYTHONUNBUFFERED="1", ROS_LOG_DIR=str(tmp_path / "log"))
     sim = subprocess.Popen(
-        [sys.executable, "-P", "-m", "sim_bridge.bringup", "--domain-id", "209",
+        [sys.executable, "-P", "-m", "sim_bridge.bringup", "--domain-id", str(claim_domain(209)),
          "--mode", "realtime", "--plot", str(tmp_path / "p.png")],
         env=env, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
