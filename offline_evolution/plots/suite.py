@@ -10,7 +10,7 @@ import numpy as np
 
 from sim_bridge.maze import Maze
 from sim_bridge.maze_plot import draw_maze
-from sim_bridge.plotting import plt, save_figure
+from sim_bridge.plotting import FIGURE_DPI, plt, save_figure
 
 REACHED_COLOUR = "tab:green"
 MISSED_COLOUR = "tab:orange"
@@ -75,4 +75,4 @@ def suite_figure(
 
 def plot_suite(mazes, path: str | os.PathLike, **kwargs) -> None:
     """Save :func:`suite_figure` at ``path`` (atomically)."""
-    save_figure(suite_figure(mazes, **kwargs), path)
+    save_figure(suite_figure(mazes, **kwargs), path, dpi=FIGURE_DPI)

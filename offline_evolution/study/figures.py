@@ -11,7 +11,6 @@
 
 from __future__ import annotations
 
-import io
 import math
 import os
 from collections.abc import Sequence
@@ -19,7 +18,6 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.colors import LogNorm
 
-from evorbc_ros.atomic_io import atomic_path
 from offline_evolution.plots.repertoire import draw_repertoire, quality_norm
 from offline_evolution.study.results import (
     CHOSEN_BINS,
@@ -27,7 +25,7 @@ from offline_evolution.study.results import (
     SelectionCounts,
     SettingResults,
 )
-from sim_bridge.plotting import plt, save_figure
+from sim_bridge.plotting import FIGURE_DPI, plt, save_figure
 
 
 def setting_label(values: dict, keys: Sequence[str]) -> str:
@@ -155,27 +153,7 @@ def example_repertoires(
         shrink=0.6,
         label=f"quality ({shown[0][1].metric})",
     )
-    _save_palette(fig, path)
-
-
-def _save_palette(fig, path: str | os.PathLike) -> None:
-    """Save ``fig`` as a 256-colour PNG (atomically) and close it.
-
-    Thousands of anti-aliased markers make a full-colour PNG of the bin-time repertoires
-    2 MB; the palette one is a third of it and looks the same (docs/study.md).
-    """
-    if not str(path).lower().endswith(".png"):
-        save_figure(fig, path)
-        return
-    from PIL import Image
-
-    buffer = io.BytesIO()
-    fig.savefig(buffer, dpi=150, format="png")
-    plt.close(fig)
-    image = Image.open(buffer).convert("RGB")
-    image = image.quantize(colors=256, method=Image.Quantize.MEDIANCUT)
-    with atomic_path(path) as tmp:
-        image.save(tmp, format="PNG", optimize=True)
+    save_figure(fig, path, dpi=FIGURE_DPI)
 
 
 def bin_time_grid(
