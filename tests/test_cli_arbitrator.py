@@ -213,7 +213,7 @@ def test_progress_says_when_a_run_resumes_from_its_checkpoint(capsys):
         if first_generation:  # what evolve() calls on restoring a checkpoint
             printer.resumed(first_generation)
         for g in (first_generation, first_generation + 1):
-            printer(GenerationStats(g, 0.4, 0.1, 0.4, 3, 26.0, 25.0, 0), None)
+            printer.generation_end(GenerationStats(g, 0.4, 0.1, 0.4, 3, 26.0, 25.0, 0), None)
         return capsys.readouterr().err.splitlines()
 
     fresh, resumed = lines(0), lines(100)
@@ -230,7 +230,7 @@ def test_the_eta_is_not_thrown_by_one_slow_generation(capsys):
 
     printer = _GenerationPrinter(quiet=False, total=110)
     for g, seconds in enumerate([30.0, 30.0, 300.0, 30.0]):  # generation 3 paused 270 s
-        printer(GenerationStats(g, 0.4, 0.1, 0.4, 3, seconds, seconds, 0), None)
+        printer.generation_end(GenerationStats(g, 0.4, 0.1, 0.4, 3, seconds, seconds, 0), None)
     lines = capsys.readouterr().err.splitlines()
     # 107 generations left at 30 s each, the slow one shown as it was but not projected
     assert "300.00 s/gen  eta  53.5 min" in lines[2]

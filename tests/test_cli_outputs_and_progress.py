@@ -97,7 +97,7 @@ def test_the_generation_eta_leaves_out_the_compiling_first_generation(capsys):
     printer = _GenerationPrinter(False, 40)
     # The first generation compiles (12 s); the others take 0.5 s: 20 s in all.
     for g, seconds in enumerate([12.0, 0.5, 0.5, 0.5, 0.6]):
-        printer(Stats(g, seconds), None)
+        printer.generation_end(Stats(g, seconds), None)
     lines = capsys.readouterr().err.splitlines()
     assert lines[0].endswith("s/gen  eta   --") and lines[1].endswith("s/gen  eta   --")
     assert lines[2].endswith("eta   0.3 min")  # 37 generations x 0.5 s, not x 12 s
@@ -106,8 +106,8 @@ def test_the_generation_eta_leaves_out_the_compiling_first_generation(capsys):
 
 def test_the_last_generation_says_done(capsys):
     printer = _GenerationPrinter(False, 2)
-    printer(Stats(0, 3.0), None)
-    printer(Stats(1, 0.5), None)
+    printer.generation_end(Stats(0, 3.0), None)
+    printer.generation_end(Stats(1, 0.5), None)
     assert capsys.readouterr().err.splitlines()[-1].endswith("done")
 
 

@@ -25,6 +25,7 @@ from offline_evolution.checkpoint import (
 from offline_evolution.cli import main
 from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
+from offline_evolution.reporters import Reporter
 
 TINY = ["--initial-batch", "20", "--batch-size", "10", "--iterations", "6", "--quiet"]
 
@@ -90,15 +91,21 @@ def test_a_kept_arbitrator_checkpoint_is_complete_and_resumes_to_the_same_result
 
     s = settings(small_neat_file, generations=2, repertoire=small_repertoire)
     ckpt = tmp_path / "a.checkpoint.json"
+
     resumes = []
+
+    class Resumes(Reporter):
+        def resumed(self, generations):
+            resumes.append(generations)
+
     first = evolve(
-        s, small_repertoire, checkpoint=ckpt, keep_checkpoint=True, on_resume=resumes.append
+        s, small_repertoire, checkpoint=ckpt, keep_checkpoint=True, reporters=[Resumes()]
     )
     assert resumes == []  # a fresh run
     data = json.loads(ckpt.read_text())
     assert data["population"]["generation"] == 2 and len(data["history"]) == 2
     again = evolve(
-        s, small_repertoire, checkpoint=ckpt, keep_checkpoint=True, on_resume=resumes.append
+        s, small_repertoire, checkpoint=ckpt, keep_checkpoint=True, reporters=[Resumes()]
     )
     assert resumes == [2]  # said although only the post-evaluation was left
     same(first, again)

@@ -413,10 +413,12 @@ def test_the_post_evaluation_reports_and_leaves_a_given_tasks_reporter(
 
     task.progress = mine
     reports = []
-    result = evolve(
-        s, small_repertoire, task=task,
-        post_progress=lambda done, total: reports.append((done, total)),
-    )  # fmt: skip
+    # The callback of the API before reporters still works, and says what replaces it.
+    with pytest.warns(DeprecationWarning, match=r"pass reporters=\[\.\.\.\]"):
+        result = evolve(
+            s, small_repertoire, task=task,
+            post_progress=lambda done, total: reports.append((done, total)),
+        )  # fmt: skip
     assert task.progress is mine
     assert result.post_evaluation.candidates > 0
     # the 4WS kernel runs the post-evaluation in one call and does not report

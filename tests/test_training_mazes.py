@@ -19,6 +19,7 @@ from offline_evolution.maze_task.task import MazeTask, MazeTaskSettings
 from offline_evolution.maze_task.training import TrainingMazes, TrainingSettings
 from offline_evolution.maze_task.world import pack_mazes
 from offline_evolution.mazes.generator import generate_maze, spec_for_robot
+from offline_evolution.reporters import Reporter
 
 TRAINING = {"generated": 2, "starts": 1, "pool": 0, "maze_seed": 5, "post_mazes": 2}
 
@@ -402,10 +403,12 @@ def test_hexapod_generated_maze_training_resumes_exactly(tmp_path):
             should_stop=lambda: polls.append(1) or len(polls) == 1,
         )  # fmt: skip
     reports = []  # the post-evaluation's progress (docs/design.md section 15)
-    resumed = evolve(
-        s, repertoire, checkpoint=ckpt, workers=2,
-        post_progress=lambda done, total: reports.append((done, total)),
-    )  # fmt: skip
+
+    class Episodes(Reporter):
+        def post_evaluation(self, done, total, finalists):
+            reports.append((done, total))
+
+    resumed = evolve(s, repertoire, checkpoint=ckpt, workers=2, reporters=[Episodes()])
     assert histories(resumed) == histories(straight)
     assert resumed.best_network == straight.best_network
     assert resumed.selected_network == straight.selected_network

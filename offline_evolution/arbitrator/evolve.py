@@ -23,7 +23,8 @@ import hashlib
 import json
 import os
 import time
-from collections.abc import Callable
+import warnings
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -66,6 +67,7 @@ from offline_evolution.checkpoint import (
     settings_mismatch,
 )
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+from offline_evolution.reporters import CallbackReporter, Reporter, Reporters
 from offline_evolution.task_protocol import ArbitratorTask
 from sim_bridge.maze import load_named_maze
 from sim_bridge.robots.design import check_simulation
@@ -640,16 +642,14 @@ def evolve(
     *,
     checkpoint: str | os.PathLike | None = None,
     checkpoint_every: int = 10,
-    progress: Callable[[GenerationStats, EvolutionSettings], None] | None = None,
+    reporters: Sequence[Reporter] = (),
     should_stop: Callable[[], bool] | None = None,
     workers: int | None = None,
     repertoire_source: str = "the repertoire",
     keep_checkpoint: bool = False,
     task: ArbitratorTask | None = None,
-    on_resume: Callable[[int], None] | None = None,
-    post_progress: Callable[[int, int], None] | None = None,
-    final_progress: Callable[[int, int], None] | None = None,
     initial_network: NetworkSpec | None = None,
+    **callbacks: Callable | None,
 ) -> EvolutionResult:
     """Run NEAT on a task to the last generation (exported as ``evolve_arbitrator``).
 
@@ -658,7 +658,8 @@ def evolve(
         repertoire: the repertoire an EvoRBC arbitrator chooses from.
         checkpoint: resumed from if it exists, written every ``checkpoint_every``
             generations, removed at the end (unless ``keep_checkpoint``).
-        progress: called after every generation.
+        reporters: told of the run as it goes (:mod:`offline_evolution.reporters`): a
+            resume, every generation's end, the post-evaluation's episodes.
         should_stop: polled after every generation and after every batch of the
             post-evaluation; True saves and raises
             :class:`~offline_evolution.repertoire.map_elites.Interrupted` (a stop asked for
@@ -673,22 +674,19 @@ def evolve(
         task: the task to evolve on (any :class:`~offline_evolution.task_protocol.
             ArbitratorTask`); by default the maze task ``settings.task`` describes for
             ``settings.robot``. A task given here is left open for the caller.
-        on_resume: called with the generations already done when the run resumes from
-            ``checkpoint`` (before anything runs; also when only the post-evaluation is
-            left).
-        post_progress: called as ``(done, total)`` while the post-evaluation's episodes
-            run, on tasks that report (the legged robots': it can take many minutes).
-        final_progress: the same for its finalists' round (``post_finalists``; default
-            ``post_progress``).
         initial_network: the network a run with ``settings.initial_network`` starts from
             (:mod:`~offline_evolution.arbitrator.warm_start`); a run that resumes from
             ``checkpoint`` only checks its fingerprint (the checkpoint holds the population).
+        callbacks: the callbacks it took before reporters, ``progress``, ``on_resume``,
+            ``post_progress`` and ``final_progress``: still taken, with a
+            DeprecationWarning naming ``reporters``.
 
     Raises:
         RepertoireError: the repertoire was evolved for another simulated robot.
         CheckpointError: the checkpoint exists but belongs to another run or is corrupt.
         ConfigError: the initial network does not fit the run.
     """
+    report = Reporters([*reporters, *_legacy_reporter(callbacks)])
     resuming = checkpoint is not None and os.path.exists(checkpoint)
     given = initial_network
     if resuming and given is not None and network_fingerprint(given) != settings.initial_network:
@@ -700,14 +698,12 @@ def evolve(
         elapsed = 0.0
         if resuming:
             elapsed = run.restore(checkpoint)
-            if on_resume is not None:
-                on_resume(run.generation)
+            report.resumed(run.generation)
         start = time.perf_counter() - elapsed
         saved = run.generation
         while not run.finished:
             stats = run.step()
-            if progress is not None:
-                progress(stats, settings)
+            report.generation_end(stats, settings)
             stop = should_stop is not None and should_stop() and not run.finished
             due = checkpoint is not None and run.generation % max(1, checkpoint_every) == 0
             if checkpoint is not None and (due or stop) and not run.finished:
@@ -727,12 +723,37 @@ def evolve(
                 during = f"the post-evaluation ({done} of {total} {what} done)"
                 raise Interrupted(run.generation, _path(checkpoint), during)
 
-        result = run.result(time.perf_counter() - start, post_progress, after_batch, final_progress)
+        result = run.result(
+            time.perf_counter() - start,
+            report.episodes(finalists=False),
+            after_batch,
+            report.episodes(finalists=True),
+        )
         if checkpoint is not None and not keep_checkpoint and os.path.exists(checkpoint):
             os.remove(checkpoint)
         return result
     finally:
         run.close()
+
+
+#: The callbacks evolve() took before reporters.
+_CALLBACKS = ("progress", "on_resume", "post_progress", "final_progress")
+
+
+def _legacy_reporter(callbacks: dict) -> list[Reporter]:
+    """A reporter for the callbacks of the old API, with a DeprecationWarning; none if none."""
+    unknown = set(callbacks) - set(_CALLBACKS)
+    if unknown:
+        raise TypeError(f"evolve() got an unexpected keyword argument {sorted(unknown)[0]!r}")
+    if not any(v is not None for v in callbacks.values()):
+        return []
+    warnings.warn(
+        f"evolve({', '.join(sorted(callbacks))}=...) is deprecated: pass "
+        "reporters=[...] (offline_evolution.reporters.Reporter)",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    return [CallbackReporter(**callbacks)]
 
 
 def _started_elsewhere(saved: dict, now: dict) -> str:

@@ -26,6 +26,7 @@ from offline_evolution.commands.common import (
     running,
     write_then_discard,
 )
+from offline_evolution.reporters import Reporter
 from sim_bridge.cli_options import add_repertoire, add_robot, add_seed, add_task
 from sim_bridge.cli_support import check_output_file, integer_in
 
@@ -101,7 +102,7 @@ def add_parsers(sub) -> None:
     std.set_defaults(func=cmd_evolve, kind=STANDARD)
 
 
-class _GenerationPrinter:
+class _GenerationPrinter(Reporter):
     """One line per generation on stderr, with an ETA once it means something.
 
     The first generation a process runs also compiles the simulation kernels (seconds
@@ -126,7 +127,8 @@ class _GenerationPrinter:
             file=sys.stderr,
         )
 
-    def __call__(self, stats, settings) -> None:
+    def generation_end(self, stats, settings) -> None:
+        """Print the generation's line."""
         if self.quiet:
             return
         self.recent.append(stats.seconds)
@@ -148,6 +150,20 @@ class _GenerationPrinter:
         return f"eta {remaining / 60:5.1f} min"
 
 
+class _PostEvaluationPrinter(Reporter):
+    """The post-evaluation's episodes as lines on stderr, round by round (``EpisodeProgress``)."""
+
+    def __init__(self) -> None:
+        self.rounds = {
+            False: EpisodeProgress("post-evaluation"),
+            True: EpisodeProgress("post-evaluation, finalists"),
+        }
+
+    def post_evaluation(self, done: int, total: int, finalists: bool) -> None:
+        """Pass the count to that round's lines."""
+        self.rounds[finalists](done, total)
+
+
 def _run(args, settings, every: int, repertoire, checkpoint: Path, initial_network=None):
     """Evolve (resuming from ``checkpoint``); the :class:`EvolutionResult`."""
     from offline_evolution.arbitrator.evolve import CHECKPOINT_KIND, evolve
@@ -162,10 +178,7 @@ def _run(args, settings, every: int, repertoire, checkpoint: Path, initial_netwo
             repertoire,
             checkpoint=checkpoint,
             checkpoint_every=every,
-            progress=printer,
-            on_resume=printer.resumed,
-            post_progress=None if args.quiet else EpisodeProgress("post-evaluation"),
-            final_progress=None if args.quiet else EpisodeProgress("post-evaluation, finalists"),
+            reporters=[printer] if args.quiet else [printer, _PostEvaluationPrinter()],
             should_stop=stop,
             workers=args.workers or None,
             repertoire_source=args.repertoire if repertoire else "the repertoire",
