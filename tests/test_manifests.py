@@ -27,6 +27,7 @@ ROSDEP = {
     "numpy": "python3-numpy",
     "yaml": "python3-yaml",
     "matplotlib": "python3-matplotlib",
+    "PIL": "python3-pil",
     "numba": "python3-numba",
     "pybullet": "python3-pybullet-pip",
     "pybullet_data": "python3-pybullet-pip",
