@@ -10,8 +10,11 @@ from neat_helpers import neat_config, network_spec, random_genomes
 from evorbc_ros.mapping import MappingFunction, nearest_brute_force
 from evorbc_ros.network import NetworkSpec, NodeSpec
 from evorbc_ros.robots.hexapod import HexapodGeometry
+from offline_evolution.maze_task.base import NOT_RUN
 from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
+from offline_evolution.maze_task.replay import cycles_run
 from offline_evolution.maze_task.task import MazeTaskSettings, eq5_fitness
+from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.maze import load_named_maze
 
 EPISODE = 2.0  # s: 20 control cycles, enough to see the robot walk and turn
@@ -97,6 +100,24 @@ def test_a_standard_network_drives_all_37_parameters(repertoire):
     # A fall ends the episode where the robot lies; eq. 5 scores it there over all of T.
     for e in np.flatnonzero(r.fell):
         assert not ran[e, -1] and r.cycles[e] == 20 and not r.reached[e]
+    assert [cycles_run(r, e) for e in range(2)] == ran.sum(axis=1).tolist()
+
+
+def test_replay_times_a_fall_by_the_cycles_run_as_the_bridge_does():
+    # Episodes of 20 cycles: one fell in its 7th cycle, one reached the target in 12, one
+    # ran out. eq. 5 scores the fall over all 20 (cycles stays 20); its time is 0.7 s.
+    choice = np.full((3, 20), NOT_RUN)
+    choice[0, :7], choice[1, :12], choice[2, :] = 4, 4, 4
+    r = EpisodeResult(
+        reached=np.array([False, True, False]),
+        cycles=np.array([20, 12, 20]),
+        final_distance=np.zeros(3),
+        initial_distance=np.ones(3),
+        fitness=np.zeros(3),
+        choice=choice,
+        fell=np.array([True, False, False]),
+    )
+    assert [cycles_run(r, e) for e in range(3)] == [7, 12, 20]
 
 
 def test_the_primitive_nearest_the_mapped_point_drives_the_robot(repertoire):

@@ -9,7 +9,7 @@ import numpy as np
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.mapping import NO_PRIMITIVE
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.maze_task.base import MazeTaskBase
+from offline_evolution.maze_task.base import NOT_RUN, MazeTaskBase
 from offline_evolution.task_protocol import EpisodeResult
 
 
@@ -19,7 +19,7 @@ class MazeOutcome:
 
     maze: str
     reached: bool
-    time: float  # s until the target was reached, or the full episode
+    time: float  # s until the target was reached or the robot fell, or the full episode
     fitness: float  # eq. 5
     final_distance: float  # m, to the target
     start: tuple[float, float, float]  # x m, y m, heading rad
@@ -41,6 +41,18 @@ class MazeOutcome:
             "fell": self.fell,
             "stopped_cycles": self.stopped_cycles,
         }
+
+
+def cycles_run(result: EpisodeResult, e: int) -> int:
+    """The control cycles recorded episode ``e`` ran: to the target, the fall or the end.
+
+    A fall ends an episode although eq. 5 scores it over the whole episode (its
+    ``cycles`` stays ``n_cycles``); its time is that of the cycles run, as the bridge
+    reports it ("fell over after 11.7 s").
+    """
+    if result.fell is not None and result.fell[e]:
+        return int(np.sum(result.choice[e] != NOT_RUN))
+    return int(result.cycles[e])
 
 
 def replay(
@@ -67,7 +79,8 @@ def replay(
     result = task.evaluate([arbitrator.network], controller, starts, record=True)
     outcomes = []
     for e, row in enumerate(starts):
-        n = int(result.cycles[e])
+        fell = bool(result.fell[e]) if result.fell is not None else False
+        n = cycles_run(result, e)
         choice = result.choice[e, :n]
         switches = float(np.mean(choice[1:] != choice[:-1])) if n > 1 else 0.0
         if arbitrator.kind.uses_repertoire:
@@ -83,7 +96,7 @@ def replay(
                 final_distance=float(result.final_distance[e]),
                 start=(float(row[1]), float(row[2]), float(row[3])),
                 switches_per_cycle=switches if arbitrator.kind.uses_repertoire else 0.0,
-                fell=bool(result.fell[e]) if result.fell is not None else False,
+                fell=fell,
                 stopped_cycles=stopped,
             )
         )
