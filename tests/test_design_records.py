@@ -18,6 +18,25 @@ def test_mismatch_names_the_innermost_setting():
     assert settings_mismatch(saved, saved) is None
 
 
+def test_mismatch_inside_lists_names_the_entry_and_stays_short():
+    # A legged robot's oscillator set: 12 joints of 6 numbers. Refusing another robot's
+    # file used to print both whole sets, a 2 KB line (issue 41).
+    joints = [{"joint": f"leg{k}", "phase": 0.25 * k, "range": [0.1] * 4} for k in range(12)]
+    other = [dict(j) for j in joints]
+    other[3] = {**other[3], "phase": 0.5}
+    saved, now = {"simulation": {"oscillators": joints}}, {"simulation": {"oscillators": other}}
+    assert settings_mismatch(saved, now, "the repertoire") == (
+        "simulation.oscillators[3].phase is 0.75 in the repertoire but 0.5 now"
+    )
+    fewer = {"simulation": {"oscillators": joints[:8]}}
+    assert settings_mismatch(saved, fewer, "the repertoire") == (
+        "simulation.oscillators has 12 entries in the repertoire but 8 now"
+    )
+    long = {"simulation": {"oscillators": "x" * 500}}
+    line = settings_mismatch(saved, long, "the repertoire")
+    assert line.startswith("simulation.oscillators is [{'joint': 'leg0'") and len(line) < 200
+
+
 def test_arbitrator_cli_refuses_a_hexapod_repertoire_of_another_design(tmp_path, capsys):
     rep = tripod_repertoire()
     geometry = rep.algorithm["simulation"]["geometry"]

@@ -244,15 +244,42 @@ def find_value(data: Any, wanted, where: str = "") -> tuple[str, Any] | None:
 def first_difference(saved: dict, current: dict, where: str) -> str | None:
     """Describe the first key whose value differs between a saved record and now.
 
-    Nested dicts are compared key by key, so the message names the innermost setting
-    (``geometry.max_joint_velocity is 10.0 in <where> but 5.0 now``); None if equal.
+    Nested dicts are compared key by key and lists of equal length entry by entry, so the
+    message names the innermost setting (``geometry.max_joint_velocity is 10.0 in <where>
+    but 5.0 now``, ``oscillators[3].phase is ...``); lists of other lengths say so, and a
+    long value is shortened, so the line stays short whatever the records hold. None if
+    equal.
     """
     for key in sorted(set(saved) | set(current)):
-        old, new = saved.get(key), current.get(key)
-        if isinstance(old, dict) and isinstance(new, dict):
-            inner = first_difference(old, new, where)
-            if inner:
-                return f"{key}.{inner}"
-        elif old != new:
-            return f"{key} is {old!r} in {where} but {new!r} now"
+        inner = _value_difference(saved.get(key), current.get(key), where)
+        if inner:
+            return f"{key}{inner}"
     return None
+
+
+#: Characters of a value a difference shows before shortening it.
+_SHOWN = 60
+
+
+def _value_difference(old, new, where: str) -> str | None:
+    """How ``old`` (saved) and ``new`` differ, as a suffix to their key; None if equal."""
+    if isinstance(old, dict) and isinstance(new, dict):
+        inner = first_difference(old, new, where)
+        return f".{inner}" if inner else None
+    if isinstance(old, list) and isinstance(new, list):
+        if len(old) != len(new):
+            return f" has {len(old)} entries in {where} but {len(new)} now"
+        for k, (a, b) in enumerate(zip(old, new, strict=True)):
+            inner = _value_difference(a, b, where)
+            if inner:
+                return f"[{k}]{inner}"
+        return None
+    if old != new:
+        return f" is {_shown(old)} in {where} but {_shown(new)} now"
+    return None
+
+
+def _shown(value) -> str:
+    """``repr(value)``, shortened past :data:`_SHOWN` characters."""
+    text = repr(value)
+    return text if len(text) <= _SHOWN else f"{text[: _SHOWN - 5]}...{text[-2:]}"
