@@ -49,6 +49,28 @@ def test_arbitrator_writes_file_curve_and_summary(evolved, tmp_path):
     assert not (tmp_path / "a.json.checkpoint.json").exists()
 
 
+def test_the_population_and_the_post_selection_size_are_options(
+    tmp_path, capsys, small_repertoire, small_neat_file, small_task_file
+):
+    rep = tmp_path / "r.json"
+    small_repertoire.save(rep)
+    argv = ["arbitrator", "--repertoire", rep, "--generations", 2, "--seed", 2, "--quiet"]
+    argv += ["--neat-config", small_neat_file, "--task", small_task_file]
+    out = tmp_path / "a.json"
+    code, _, err = run(capsys, *argv, "--population", 12, "--post-samples", 1, "--out", out)
+    assert code == 0, err
+    evolution = ArbitratorFile.load(out).evolution
+    assert evolution["population"] == 12  # recorded: the NEAT file says 24
+    assert evolution["post_evaluation"]["samples_per_maze"] == 1
+    code, _, err = run(capsys, *argv, "--out", tmp_path / "b.json")
+    assert code == 0, err
+    evolution = ArbitratorFile.load(tmp_path / "b.json").evolution
+    assert "population" not in evolution  # the file's pop_size: files as before
+    # A population the file's species settings cannot hold is refused in one line.
+    code, _, err = run(capsys, *argv, "--population", 3, "--out", tmp_path / "c.json")
+    assert code != 0 and len(err.strip().splitlines()) == 1 and "pop_size 3" in err, err
+
+
 def test_replay_reports_each_maze(evolved, tmp_path, capsys):
     out, _, _, _ = evolved
     code, stdout, err = run(

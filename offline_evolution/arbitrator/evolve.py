@@ -133,13 +133,18 @@ class EvolutionSettings:
     # fingerprint (what a checkpoint compares) and the file it came from (recorded only).
     initial_network: str | None = None
     initial_network_file: str | None = None
+    # The population, when it replaces the NEAT file's pop_size (``--population``).
+    population: int | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "kind", controller_kind(self.kind))
 
     def as_dict(self) -> dict:
         """Plain-data form (checkpoints and arbitrator files)."""
-        return {**dataclasses.asdict(self), "kind": self.kind.name}
+        data = {**dataclasses.asdict(self), "kind": self.kind.name}
+        if data["population"] is None:  # the NEAT file's: files stay as they were
+            del data["population"]
+        return data
 
 
 @dataclass(frozen=True)
@@ -320,7 +325,9 @@ class Evolution:
                 raise
         n_outputs = settings.kind.n_outputs(len(self.task.parameter_specs))
         self.controller = self.task.controller(settings.kind, repertoire, settings.mapping)
-        self.config = load_neat_config(settings.neat_file, self.task.layout.n_inputs, n_outputs)
+        self.config = load_neat_config(
+            settings.neat_file, self.task.layout.n_inputs, n_outputs, settings.population
+        )
         threshold = self.config.species_set_config.compatibility_threshold
         self.population = neat.Population(self.config, seed=settings.seed)
         # A run that starts from a network and is not given it can only continue from a
@@ -815,6 +822,8 @@ def arbitrator_file(
         "task": s.task,
         "history": [h.as_dict() for h in result.history],
     }
+    if s.population is not None:  # --population: the NEAT file's pop_size was replaced
+        evolution["population"] = s.population
     simulation = task.describe()
     if simulation is not None:
         evolution["simulation"] = simulation  # the robot the controller was evolved on

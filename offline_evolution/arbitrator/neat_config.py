@@ -39,8 +39,13 @@ NON_NEGATIVE_SUFFIXES = ("_stdev", "_mutate_power", "_coefficient")
 NON_NEGATIVE = ("num_hidden", "species_elitism", "max_stagnation", "elitism")
 
 
-def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int) -> neat.Config:
+def load_neat_config(
+    path: str | os.PathLike, num_inputs: int, num_outputs: int, pop_size: int | None = None
+) -> neat.Config:
     """neat-python's Config from ``path`` with the task's numbers of inputs and outputs.
+
+    ``pop_size`` replaces the file's ``[NEAT] pop_size`` (``--population``); the file's
+    other settings must still fit it (species sizes, elitism), checked as for the file's.
 
     Raises:
         ConfigError: one line naming the file and the problem (missing file, bad syntax,
@@ -60,6 +65,9 @@ def load_neat_config(path: str | os.PathLike, num_inputs: int, num_outputs: int)
             "class; see config/neat/4ws.ini)"
         )
     _check_limits(parser[GENOME_SECTION], source)
+    if pop_size is not None and parser.has_section("NEAT"):
+        parser["NEAT"]["pop_size"] = str(pop_size)
+        source = f"{source} with pop_size {pop_size}"
     parser[GENOME_SECTION]["num_inputs"] = str(num_inputs)
     parser[GENOME_SECTION]["num_outputs"] = str(num_outputs)
     # Users write neat-python's section name; the class that reads it is evorbc's.

@@ -38,6 +38,20 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help="NEAT generations (default: the robot's run settings, Table I)",
     )
+    p.add_argument(
+        "--population",
+        type=integer_in(2, bounds.POP_SIZE),
+        metavar="N",
+        help="NEAT population, in place of the NEAT file's pop_size (its species and "
+        "elitism settings must fit it)",
+    )
+    p.add_argument(
+        "--post-samples",
+        type=integer_in(1, bounds.MAZES),
+        metavar="N",
+        help="random starts per maze of each hall-of-fame genome in the post-selection "
+        "(default: the run settings'; fewer is quicker, less sure)",
+    )
     add_seed(p, "random seed")
     p.add_argument("--out", required=True, metavar="FILE", help="arbitrator file to write (JSON)")
     p.add_argument(
@@ -239,13 +253,16 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     # work.
     layout = SensorLayout.load(config_dir() / task_settings.sensors)
     n_outputs = args.kind.n_outputs(lookup(robot).n_parameters)
-    neat_config = load_neat_config(neat_file, layout.n_inputs, n_outputs)
+    neat_config = load_neat_config(neat_file, layout.n_inputs, n_outputs, args.population)
     mapping = (args.mapping or run.mapping) if args.kind.uses_repertoire else None
     initial_network = None
     if args.init_from:
         initial_network = load_initial_network(
             args.init_from, robot, args.kind, mapping, layout, neat_config, str(neat_file)
         )
+    selection = run.selection()
+    if args.post_samples is not None:
+        selection["post_samples"] = args.post_samples
     settings = EvolutionSettings(
         kind=args.kind,
         robot=robot,
@@ -256,9 +273,10 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         task=task_settings.as_dict(),
         mapping=mapping,
         repertoire_fingerprint=repertoire.fingerprint() if repertoire else None,
-        **run.selection(),
+        **selection,
         initial_network=network_fingerprint(initial_network) if initial_network else None,
         initial_network_file=args.init_from,
+        population=args.population,
     )
     check_distinct(
         {
@@ -277,7 +295,7 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         robot,
         str(args.task or run.task_path()),
         3 * run.hall_of_fame + (generations // run.snapshot_every if run.snapshot_every else 0),
-        run.post_samples,
+        selection["post_samples"],
         run.post_finalists,
         run.post_final_samples,
         neat_source=str(neat_file),
