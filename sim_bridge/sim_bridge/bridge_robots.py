@@ -25,6 +25,7 @@ from evorbc_ros.robots.four_ws import WHEEL_NAMES
 from evorbc_ros.robots.hexapod import JOINT_NAMES
 from evorbc_ros.robots.registry import RobotError
 from sim_bridge.hexapod.maze_world import HexapodMazeWorld
+from sim_bridge.robots.adapters import bridge_class
 from sim_bridge.world import LaserConfig, SimWorld
 
 STEERING_JOINTS = [f"{w}_steering_joint" for w in WHEEL_NAMES]
@@ -262,13 +263,13 @@ class HexapodBridge(TrajectoryBridge):
 
 
 def bridge_robot_class(robot: str) -> type:
-    """The adapter class ``robot``'s registration names.
+    """The bridge adapter class of ``robot``'s family (:mod:`sim_bridge.robots.adapters`).
 
     Raises:
         StartupError: an unknown robot (listing the known ones), or an adapter that cannot
             be imported.
     """
     try:
-        return robot_named(robot).load("bridge")
+        return bridge_class(robot_named(robot))
     except RobotError as e:
         raise StartupError(str(e)) from None
