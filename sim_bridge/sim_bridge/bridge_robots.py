@@ -6,8 +6,8 @@ are :class:`HexapodBridge` and, for any legged robot from a settings file,
 owns its simulated world, subscribes its command topics, fills the joint states and laser
 scan, and steps the world with the commands of the cycle. The bridge node
 (:mod:`sim_bridge.bridge_node`) runs the loop, clock, odometry and result the same way for
-every robot, and finds a robot's adapter through its registration's ``bridge`` field
-(docs/your-robot.md gives the adapter's interface).
+every robot, and finds a robot's adapter by its family (:mod:`sim_bridge.robots.adapters`;
+docs/your-robot.md gives the adapter's interface).
 """
 
 from __future__ import annotations

@@ -71,7 +71,7 @@ class FourWSRobot:
 
 
 def simulated_robot(robot, workers: int | None = None) -> FourWSRobot:
-    """A 4WS registration's simulated robot (its ``simulation`` factory).
+    """A 4WS registration's simulated robot (the ``four_ws`` family's ``simulation``).
 
     Args:
         robot: the :class:`~evorbc_ros.robots.registry.Robot`; its ``model`` is the type.
