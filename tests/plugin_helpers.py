@@ -123,3 +123,80 @@ def install(src: Path, site: Path) -> Path:
 def build_plugin(root: Path, module: str = MODULE) -> Path:
     """Write and install the plugin; the folder to put on ``PYTHONPATH``."""
     return install(write_package(root, module), root / "site")
+
+
+#: A package with a robot of a family of its own, declared in each layer's group, and a
+#: robot declared the deprecated way (factories on the record). Its "own" code is the 4WS
+#: robots', so both must move exactly as 4ws-5 does.
+TRACKS_PYPROJECT = """\
+[build-system]
+requires = ["setuptools>=61"]
+build-backend = "setuptools.build_meta"
+
+[project]
+name = "evorbc-tracks"
+version = "0.2.0"
+dependencies = ["evorbc"]
+
+[project.entry-points."evorbc.robots"]
+tracks = "evorbc_tracks:robots"
+
+[project.entry-points."evorbc.sim_adapters"]
+tracked = "evorbc_tracks.sim:ADAPTERS"
+
+[project.entry-points."evorbc.search_adapters"]
+tracked = "evorbc_tracks.search:adapters"
+"""
+TRACKS_MODULE = '''\
+"""evorbc_tracks: robots of a family of its own ("tracked") and one declared the old way."""
+
+import dataclasses
+
+from evorbc_ros.robots.builtin.four_ws import four_ws_robot
+from evorbc_ros.robots.four_ws import ROBOT_TYPES
+
+
+def robots():
+    """The entry point: the onboard records only."""
+    new = four_ws_robot(dataclasses.replace(ROBOT_TYPES["4ws-5"], name="tracks"), family="tracked")
+    old = four_ws_robot(
+        dataclasses.replace(ROBOT_TYPES["4ws-5"], name="oldtracks"),
+        family="",
+        simulation="sim_bridge.robots.four_ws:simulated_robot",
+        task="offline_evolution.maze_task.factories:kinematic_task",
+        bridge="sim_bridge.bridge_robots:FourWSBridge",
+    )
+    return [new, old]
+'''
+TRACKS_SIM = '''\
+"""The simulation's adapters of the "tracked" family (the sim layer imports this)."""
+
+from sim_bridge.robots.adapters import SimAdapters
+
+ADAPTERS = SimAdapters(
+    simulation="sim_bridge.robots.four_ws:simulated_robot",
+    bridge="sim_bridge.bridge_robots:FourWSBridge",
+)
+'''
+TRACKS_SEARCH = '''\
+"""The search's adapters of the "tracked" family (the search layer imports this)."""
+
+from offline_evolution.maze_task.adapters import SearchAdapters
+
+
+def adapters():
+    """A callable entry point, as a registration's may be."""
+    return SearchAdapters(task="offline_evolution.maze_task.factories:kinematic_task")
+'''
+
+
+def build_tracks(root: Path) -> Path:
+    """Write and install evorbc-tracks; the folder to put on ``PYTHONPATH``."""
+    src = root / "evorbc-tracks"
+    package = src / "evorbc_tracks"
+    package.mkdir(parents=True)
+    (src / "pyproject.toml").write_text(TRACKS_PYPROJECT)
+    (package / "__init__.py").write_text(TRACKS_MODULE)
+    (package / "sim.py").write_text(TRACKS_SIM)
+    (package / "search.py").write_text(TRACKS_SEARCH)
+    return install(src, root / "site")

@@ -2,6 +2,7 @@
 registry, its settings files, its maze, its executor, and the CLI pipeline (repertoire,
 arbitrator, replay)."""
 
+import dataclasses
 import json
 import math
 import os
@@ -17,6 +18,7 @@ from evorbc_ros.config import config_dir
 from evorbc_ros.legged_executor import LeggedExecutor
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.legged import LeggedGaitTable
+from evorbc_ros.robots.record import load_path
 from offline_evolution.mazes.paths import solve
 from sim_bridge.legged.evaluate import HEADING, X, Y, evaluate_genes
 from sim_bridge.legged.physics import LeggedSim
@@ -32,8 +34,12 @@ def test_the_a1_is_a_legged_robot_from_its_urdf_and_settings():
     assert a1.parameters == settings.gait.parameter_specs()
     assert a1.max_speed == settings.speed_bound and a1.footprint_radius == 0.40
     assert settings.urdf.endswith(os.path.join("a1", "a1.urdf"))  # pybullet_data's
-    for field in ("simulation", "task", "bridge", "commands", "design_check"):
-        a1.load(field)  # every factory imports
+    from offline_evolution.maze_task import adapters as search
+    from sim_bridge.robots import adapters as sim
+
+    assert a1.family == "legged"
+    for path in (*dataclasses.astuple(sim.TABLE.adapters(a1)), search.TABLE.adapters(a1).task):
+        assert load_path(path, "a1") is not None  # every factory imports
     # Its joint trajectories come at its physics rate unless told otherwise.
     assert a1.load("commands").default_rate(a1) == settings.physics.rate == 100.0
     with LeggedSim(settings) as sim:

@@ -9,7 +9,8 @@ from neat_helpers import neat_config, network_spec, random_genomes
 from evorbc_ros.arbitrator import Arbitrator, ArbitratorError, ArbitratorFile, DirectController
 from evorbc_ros.config import config_dir
 from evorbc_ros.repertoire import Repertoire
-from evorbc_ros.robots.four_ws import FourWSGeometry, robot_type
+from evorbc_ros.robots.four_ws import FourWSGeometry
+from evorbc_ros.robots.registry import robot_type
 from evorbc_ros.sensors import SensorLayout
 
 LAYOUT = SensorLayout.load(config_dir() / "sensors" / "4ws.yaml")

@@ -5,7 +5,8 @@ import pytest
 
 from evorbc_ros.executor import PrimitiveExecutor
 from evorbc_ros.laser import InputError
-from evorbc_ros.robots.four_ws import FourWSGeometry, robot_type
+from evorbc_ros.robots.four_ws import FourWSGeometry
+from evorbc_ros.robots.registry import robot_type
 
 
 def executor():

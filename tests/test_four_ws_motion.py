@@ -6,7 +6,8 @@ import numba
 import numpy as np
 import pytest
 
-from evorbc_ros.robots.four_ws import FourWSGeometry, robot_type
+from evorbc_ros.robots.four_ws import FourWSGeometry
+from evorbc_ros.robots.registry import robot_type
 from sim_bridge.four_ws_motion import (
     HEADING,
     SPEED,
@@ -14,10 +15,10 @@ from sim_bridge.four_ws_motion import (
     X,
     Y,
     motion_limits,
-    run_primitives,
     step_robot,
 )
 from sim_bridge.geometry import wall_boxes
+from sim_bridge.kinematics import run_primitives
 
 G = FourWSGeometry()
 LIM = motion_limits(G)

@@ -15,8 +15,9 @@ import pytest
 from reference_four_ws import Margins, State, reference_primitive, reference_step
 
 from evorbc_ros.robots.four_ws import FourWSGeometry
-from sim_bridge.four_ws_motion import STATE_SIZE, motion_limits, run_primitives, step_robot
+from sim_bridge.four_ws_motion import STATE_SIZE, motion_limits, step_robot
 from sim_bridge.geometry import wall_boxes
+from sim_bridge.kinematics import run_primitives
 
 TOL = 1e-9  # m and rad
 MARGIN = 1e-9  # keep inputs this far from every threshold

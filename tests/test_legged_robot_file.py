@@ -44,7 +44,7 @@ def test_a_legged_robot_file_registers_a_robot_that_walks_as_its_model(user_robo
     a1 = registry.lookup("a1")
     assert robot.description == "my quadruped" and robot.maze == "a1"
     assert robot.parameter_names == a1.parameter_names  # the A1's 25 genes
-    assert robot.commands == a1.commands and robot.bridge == a1.bridge
+    assert robot.commands == a1.commands and robot.family == a1.family == "legged"
     genes = np.random.default_rng(3).uniform(-1, 1, (3, a1.n_parameters))
     mine, theirs = make_robot("mydog", workers=1), make_robot("a1", workers=1)
     try:

@@ -27,7 +27,8 @@ from evorbc_ros.mapping import (
     clamped_cell,
 )
 from evorbc_ros.repertoire import Repertoire
-from evorbc_ros.robots.four_ws import FourWSGeometry, robot_type
+from evorbc_ros.robots.four_ws import FourWSGeometry
+from evorbc_ros.robots.registry import robot_type
 from offline_evolution import cli
 from offline_evolution.maze_task import kernel
 from offline_evolution.maze_task.replay import replay

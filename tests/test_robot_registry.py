@@ -93,13 +93,24 @@ def test_an_unknown_robot_in_a_settings_file_is_named_with_its_key(tmp_path):
 
 
 def test_a_factory_that_cannot_be_imported_is_one_line():
+    from sim_bridge.robots import adapters
+
+    # A record declared the deprecated way names its factory itself.
     robot = dataclasses.replace(registry.lookup("4ws-5"), simulation="nosuch.module:make")
     with pytest.raises(RobotError) as info:
-        robot.make_simulation()
+        adapters.make_simulation(robot)
     assert str(info.value) == (
         "robot 4ws-5: its simulation 'nosuch.module:make' cannot be loaded "
         "(ModuleNotFoundError: No module named 'nosuch')"
     )
+    # A family's adapters registered with a path that does not import.
+    try:
+        adapters.TABLE.register("tracked", adapters.SimAdapters("nosuch.module:make", "nosuch:B"))
+        tank = dataclasses.replace(registry.lookup("4ws-5"), name="tank", family="tracked")
+        with pytest.raises(RobotError, match=r"^robot tank: its bridge 'nosuch:B' cannot be"):
+            adapters.bridge_class(tank)
+    finally:
+        adapters.TABLE.reset()
 
 
 class FakeEntryPoint:

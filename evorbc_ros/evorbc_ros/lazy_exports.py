@@ -1,7 +1,7 @@
 """Package-level names that import their module on first use (PEP 562).
 
-``import evorbc_ros`` must stay light on a robot (numpy and PyYAML only), and ``import
-offline_evolution`` must not pull numba, PyBullet or pyribs into a command that needs
+``import evorbc_ros`` must stay light on a robot (numpy and PyYAML only), and importing the
+search package must not pull numba, PyBullet or pyribs into a command that needs
 none of them; so each package lists its public names and where they live, and a name's
 module is imported only when the name is first read (docs/design.md section 20).
 """

@@ -5,7 +5,7 @@ the same rangefinders and goal inputs cycle after cycle, so a controller without
 repeats the same choice for ever. Its distance moved over the last ``window`` seconds tells
 it (docs/design.md section 5). The radar node computes it from ``nav_msgs/Odometry`` and the
 offline legged episodes from the simulated pose with the same code; the compiled 4WS kernel
-keeps the same window of past positions (:mod:`offline_evolution.maze_task.kernel`).
+keeps the same window of past positions (docs/design.md section 5).
 
 Time is the poses' stamps in integer ns, so a lockstep graph (stamps ``k x 0.1 s``) and the
 offline episodes compare the same poses exactly.

@@ -52,7 +52,8 @@ FORMAT = "evorbc-repertoire"
 VERSION = 1
 
 #: Names of the quality metrics, with their ranges in repertoire_checks.QUALITY_RANGES
-#: (offline_evolution.quality defines the metrics and takes their ranges from there).
+#: (the search defines the metrics, docs/design.md section 3, and takes their ranges from
+#: there).
 METRICS = tuple(QUALITY_RANGES)
 
 

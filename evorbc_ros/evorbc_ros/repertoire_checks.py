@@ -19,8 +19,8 @@ import numpy as np
 from evorbc_ros.limits import ARCHIVE_CELLS
 
 #: Quality metric -> (lowest, highest) quality it can give. The metrics themselves are
-#: defined in offline_evolution.quality (which this onboard package must not import); it
-#: takes each metric's range from here, so the two cannot disagree. Heading metrics are
+#: defined by the search (docs/design.md section 3), a layer this onboard package must not
+#: import; it takes each metric's range from here, so the two cannot disagree. Heading metrics are
 #: 1 - |angle error| / pi in [0, 1]; distance is reach / path, clipped to [0, 1]; a sum
 #: of two is in [0, 2]; circular+tilt is (1 - tilt / 45 deg) + circular, tilt in [0, 45 deg].
 QUALITY_RANGES: dict[str, tuple[float, float]] = {
@@ -113,7 +113,7 @@ def _finite(value: Any) -> bool:
 
 
 def archive_problem(archive: dict, bin_size: float) -> str | None:
-    """The first problem with the archive layout (offline_evolution.repertoire.archive).
+    """The first problem with the archive layout (MAP-Elites' grid, docs/design.md section 6).
 
     The layout must be the one ``bin_size`` gives: a grid of ``dims`` cells of ``bin_size``
     m over ``[low, high]``, or a CVT with at most as many cells. The number of cells is

@@ -1,7 +1,7 @@
-"""The built-in robots' maze-task factories, named by their registrations' ``task`` field.
+"""The built-in robot families' maze-task factories (:mod:`.adapters` names them).
 
-Each is called ``task(robot, settings, workers=None)`` with the robot's registration
-(:class:`~evorbc_ros.robots.registry.Robot`) and a
+Each is called ``task(robot, settings, workers=None)`` with the robot's record
+(:class:`~evorbc_ros.robots.record.Robot`) and a
 :class:`~offline_evolution.maze_task.task.MazeTaskSettings`.
 """
 
@@ -14,8 +14,9 @@ def kinematic_task(robot, settings, workers: int | None = None):
     Its episodes run on numba's threads, in the robot's own motion model.
     """
     from offline_evolution.maze_task.task import MazeTask
+    from sim_bridge.robots.adapters import make_simulation
 
-    return MazeTask(settings, robot.make_simulation())
+    return MazeTask(settings, make_simulation(robot))
 
 
 #: The name 4WS registrations made before differential-drive robots used.

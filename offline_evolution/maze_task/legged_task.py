@@ -189,7 +189,7 @@ def _padded_traces(results: list[dict], n_cycles: int):
 
 
 def legged_task(robot, settings: MazeTaskSettings, workers: int | None = None) -> LeggedMazeTask:
-    """A legged registration's maze task (its ``task`` factory): ``robot.model``'s robot."""
+    """A legged registration's maze task (the ``legged`` family's ``task``): its model's."""
     return LeggedMazeTask(settings, str(robot.model.path()), workers=workers)
 
 

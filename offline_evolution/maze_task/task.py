@@ -144,9 +144,9 @@ class MazeTask(MazeTaskBase):
 
     def __init__(self, settings: MazeTaskSettings, robot: str | KinematicRobot):
         if isinstance(robot, str):
-            from evorbc_ros.robots.registry import lookup
+            from sim_bridge.robots import make_robot
 
-            robot = lookup(robot).make_simulation()
+            robot = make_robot(robot)
         self.robot = robot
         super().__init__(settings, robot.control_period, robot.footprint_radius, robot.name)
         self.sensors = compile_layout(self.layout, robot.control_period)
@@ -271,7 +271,7 @@ class MazeTask(MazeTaskBase):
 
 
 def make_task(settings: MazeTaskSettings, robot: str, workers: int | None = None):
-    """The maze task for ``robot``: its registration's ``task`` factory.
+    """The maze task for ``robot``: its family's task factory (:mod:`.adapters`).
 
     Args:
         workers: processes that run episodes (PyBullet robots; default: every core).
@@ -280,5 +280,6 @@ def make_task(settings: MazeTaskSettings, robot: str, workers: int | None = None
         evorbc_ros.robots.registry.UnknownRobot: naming the known robots.
     """
     from evorbc_ros.robots.registry import lookup
+    from offline_evolution.maze_task.adapters import make_task as family_task
 
-    return lookup(robot).make_task(settings, workers)
+    return family_task(lookup(robot), settings, workers)

@@ -192,7 +192,14 @@ def _command(argv: list[str]) -> None:
     The subcommand's own parser builds its options (defaults included) and its function
     runs them, exactly as the command line would.
     """
-    from offline_evolution.cli import build_parser
+    # The two subcommands a recipe runs, not evorbc-evolve's whole parser: that one holds
+    # the recipe command, which imports this module.
+    from offline_evolution.commands import arbitrator, repertoire
+    from sim_bridge.cli_support import OneLineParser
 
-    args: argparse.Namespace = build_parser().parse_args(argv)
+    parser = OneLineParser(prog="evorbc-evolve")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    repertoire.add_parsers(sub)
+    arbitrator.add_parsers(sub)
+    args: argparse.Namespace = parser.parse_args(argv)
     args.func(args)

@@ -6,8 +6,8 @@ are :class:`HexapodBridge` and, for any legged robot from a settings file,
 owns its simulated world, subscribes its command topics, fills the joint states and laser
 scan, and steps the world with the commands of the cycle. The bridge node
 (:mod:`sim_bridge.bridge_node`) runs the loop, clock, odometry and result the same way for
-every robot, and finds a robot's adapter through its registration's ``bridge`` field
-(docs/your-robot.md gives the adapter's interface).
+every robot, and finds a robot's adapter by its family (:mod:`sim_bridge.robots.adapters`;
+docs/your-robot.md gives the adapter's interface).
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from evorbc_ros.robots.four_ws import WHEEL_NAMES
 from evorbc_ros.robots.hexapod import JOINT_NAMES
 from evorbc_ros.robots.registry import RobotError
 from sim_bridge.hexapod.maze_world import HexapodMazeWorld
+from sim_bridge.robots.adapters import bridge_class
 from sim_bridge.world import LaserConfig, SimWorld
 
 STEERING_JOINTS = [f"{w}_steering_joint" for w in WHEEL_NAMES]
@@ -262,13 +263,13 @@ class HexapodBridge(TrajectoryBridge):
 
 
 def bridge_robot_class(robot: str) -> type:
-    """The adapter class ``robot``'s registration names.
+    """The bridge adapter class of ``robot``'s family (:mod:`sim_bridge.robots.adapters`).
 
     Raises:
         StartupError: an unknown robot (listing the known ones), or an adapter that cannot
             be imported.
     """
     try:
-        return robot_named(robot).load("bridge")
+        return bridge_class(robot_named(robot))
     except RobotError as e:
         raise StartupError(str(e)) from None

@@ -38,6 +38,7 @@ from sim_bridge.cli_options import add_arbitrator, add_flag, add_repertoire, add
 from sim_bridge.cli_support import OneLineParser, check_output_file, integer_in, report_unexpected
 from sim_bridge.graph import NodeSpec, exit_ends_graph, shipped_arbitrator, sim_graph
 from sim_bridge.maze import Maze, load_named_maze, maze_names
+from sim_bridge.robots.adapters import check_design
 
 #: Highest ROS_DOMAIN_ID: DDS derives UDP ports from it, and above 232 they pass 65535.
 MAX_DOMAIN_ID = 232
@@ -226,7 +227,7 @@ def prepare(args: argparse.Namespace) -> tuple[Controller, Maze, str]:
     if args.robot and arb.robot != args.robot:
         raise ConfigError(f"{arb_path}: is for robot {arb.robot}, not --robot {args.robot}")
     robot = registry.lookup(arb.robot)
-    robot.check_design(controller)  # e.g. the hexapod: the bridge's design and laser
+    check_design(robot, controller)  # e.g. the hexapod: the bridge's design and laser
     args.maze = args.maze or robot.maze
     maze = load_named_maze(args.maze)
     check_start(args.start, args.seed, maze, arb.robot)

@@ -267,24 +267,3 @@ def step_robot(state, i, command, lim, boxes, candidates):
     state[i, X] = nx
     state[i, Y] = ny
     return abs(distance)
-
-
-def run_primitives(commands, n_steps, lim):
-    """Execute 4WS primitives from rest at the origin facing +x, in free space.
-
-    Each row of ``commands`` is held constant for ``n_steps`` control steps; rate limits
-    apply throughout (docs/design.md section 2). The compiled loop is every kinematic
-    robot's (:func:`sim_bridge.kinematics.run_model_primitives`).
-
-    Args:
-        commands: ``(n, 5)`` wheel commands.
-        n_steps: number of control steps (T / dt).
-        lim: :class:`MotionLimits`.
-
-    Returns:
-        ``(n, 4)`` rows ``(x m, y m, final heading rad (unwrapped), path length m)``.
-
-    """
-    from sim_bridge.kinematics import run_model_primitives  # it imports this module
-
-    return run_model_primitives(commands, n_steps, lim)

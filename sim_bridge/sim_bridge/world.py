@@ -14,7 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from evorbc_ros.robots.four_ws import FourWSGeometry, robot_type
+from evorbc_ros.robots.four_ws import FourWSGeometry
+from evorbc_ros.robots.registry import robot_type
 from sim_bridge.four_ws_motion import (
     ANGLE_FL,
     HEADING,

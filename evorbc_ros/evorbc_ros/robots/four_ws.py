@@ -222,21 +222,3 @@ ROBOT_TYPES: dict[str, FourWSType] = {
         ),
     )
 }
-
-
-def robot_type(name: str) -> FourWSType:
-    """The 4WS robot type called ``name``: a built-in one, or a plugin's 4WS variant.
-
-    Looked up in the robot registry (:mod:`evorbc_ros.robots.registry`), whose 4WS
-    registrations carry their type as ``model``.
-
-    Raises:
-        KeyError: with a message listing the known 4WS types.
-
-    """
-    from evorbc_ros.robots import registry
-
-    if registry.known(name) and isinstance(registry.lookup(name).model, FourWSType):
-        return registry.lookup(name).model
-    known = ", ".join(r.name for r in registry.robots() if isinstance(r.model, FourWSType))
-    raise KeyError(f"unknown 4WS robot type {name!r}; expected one of {known}")

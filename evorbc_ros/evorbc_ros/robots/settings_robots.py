@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
-from evorbc_ros.robots.registry import Robot, SettingsFiles
+from evorbc_ros.robots.record import Robot, SettingsFiles
 
 #: The environment variable naming the user's folders of robot settings files.
 PATH_VARIABLE = "EVORBC_ROBOT_PATH"

@@ -1,4 +1,4 @@
-"""The hexapod's design check for ``evorbc-sim`` (its registration's ``design_check``).
+"""The hexapod's design check for ``evorbc-sim`` (its family's ``design_check``).
 
 The bridge simulates one hexapod design (geometry, servos, physics) and one laser; a
 controller evolved for another would run on a robot it was never tried on, so it is

@@ -1,4 +1,4 @@
-"""A legged robot's design check for ``evorbc-sim`` (legged registrations' ``design_check``).
+"""A legged robot's design check for ``evorbc-sim`` (the ``legged`` family's ``design_check``).
 
 The bridge simulates the design the robot's settings file describes (URDF, gait, servos,
 physics) with the laser of its registration's sensor layout; a controller evolved for

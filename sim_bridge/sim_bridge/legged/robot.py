@@ -72,7 +72,7 @@ class LeggedRobot:
 
 
 def simulated_robot(robot, workers: int | None = None) -> LeggedRobot:
-    """A legged registration's simulated robot (its ``simulation`` factory).
+    """A legged registration's simulated robot (the ``legged`` family's ``simulation``).
 
     Args:
         robot: the :class:`~evorbc_ros.robots.registry.Robot`; its ``model`` names the

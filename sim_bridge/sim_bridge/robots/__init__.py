@@ -9,7 +9,7 @@ __all__ = ["ROBOT_NAMES", "PrimitiveOutcome", "SimulatedRobot", "make_robot"]
 
 
 def make_robot(name: str, workers: int | None = None) -> SimulatedRobot:
-    """The simulated robot called ``name`` (its registration's ``simulation`` factory).
+    """The simulated robot called ``name`` (its family's ``simulation`` adapter).
 
     Args:
         name: a registered robot (:data:`ROBOT_NAMES`).
@@ -20,4 +20,6 @@ def make_robot(name: str, workers: int | None = None) -> SimulatedRobot:
         evorbc_ros.robots.registry.UnknownRobot: a KeyError naming the known robots.
 
     """
-    return lookup(name).make_simulation(workers)
+    from sim_bridge.robots.adapters import make_simulation
+
+    return make_simulation(lookup(name), workers)

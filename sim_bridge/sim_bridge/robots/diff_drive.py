@@ -64,7 +64,7 @@ class DiffDriveRobot:
 
 
 def simulated_robot(robot, workers: int | None = None) -> DiffDriveRobot:
-    """A differential-drive registration's simulated robot (its ``simulation`` factory).
+    """A differential-drive registration's simulated robot (its family's ``simulation``).
 
     Args:
         robot: the registration; its ``model`` is its :class:`DiffDriveGeometry`.

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from evorbc_ros.robots.four_ws import FourWSGeometry, FourWSType, robot_type
+from evorbc_ros.robots.four_ws import FourWSGeometry, FourWSType
 from evorbc_ros.robots.primitive import ParameterSpec
-from sim_bridge.four_ws_motion import motion_limits, run_primitives
+from evorbc_ros.robots.registry import robot_type
+from sim_bridge.four_ws_motion import motion_limits
+from sim_bridge.kinematics import run_primitives
 from sim_bridge.robots.base import PrimitiveOutcome, control_steps
 
 
@@ -69,7 +71,7 @@ class FourWSRobot:
 
 
 def simulated_robot(robot, workers: int | None = None) -> FourWSRobot:
-    """A 4WS registration's simulated robot (its ``simulation`` factory).
+    """A 4WS registration's simulated robot (the ``four_ws`` family's ``simulation``).
 
     Args:
         robot: the :class:`~evorbc_ros.robots.registry.Robot`; its ``model`` is the type.

@@ -53,7 +53,7 @@ class HexapodRobot(LeggedRobot):
 
 
 def simulated_robot(robot, workers: int | None = None) -> HexapodRobot:
-    """The hexapod registration's simulated robot (its ``simulation`` factory).
+    """The hexapod registration's simulated robot (its family's ``simulation``).
 
     Args:
         robot: the :class:`~evorbc_ros.robots.registry.Robot`.

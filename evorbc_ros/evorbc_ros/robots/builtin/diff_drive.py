@@ -8,7 +8,7 @@ figures become.
 from __future__ import annotations
 
 from evorbc_ros.robots.diff_drive import DiffDriveGeometry
-from evorbc_ros.robots.registry import Robot, SettingsFiles
+from evorbc_ros.robots.record import Robot, SettingsFiles
 
 #: The topic its command interface publishes: geometry_msgs/Twist, as a TurtleBot3's
 #: base, nav2 and ros2_control's diff_drive_controller take it.
@@ -37,9 +37,6 @@ def diff_drive_robot(name: str, geometry: DiffDriveGeometry, **changes) -> Robot
         description=changes.pop("description", "differential-drive robot, body twist genes"),
         parameters=geometry.parameter_specs(),
         settings=changes.pop("settings", SETTINGS),
-        simulation="sim_bridge.robots.diff_drive:simulated_robot",
-        task="offline_evolution.maze_task.factories:kinematic_task",
-        bridge="sim_bridge.diff_drive_bridge:DiffDriveBridge",
         commands="evorbc_ros.nodes.twist_commands:TwistCommands",
         command_topics=COMMAND_TOPICS,
         sensors=changes.pop("sensors", "sensors/turtlebot3-burger.yaml"),
@@ -47,6 +44,7 @@ def diff_drive_robot(name: str, geometry: DiffDriveGeometry, **changes) -> Robot
         episode_time=changes.pop("episode_time", 120.0),
         footprint_radius=geometry.footprint_radius,
         max_speed=geometry.max_speed,
+        family="diff_drive",
         # Its repertoire at Table I's budget is 1.01M primitives of 2 s, about 2M
         # simulated seconds: ~25 generations of 150 genomes x 5 mazes x 120 s, as the 4WS's.
         equal_budget_generations=changes.pop("equal_budget_generations", 25),

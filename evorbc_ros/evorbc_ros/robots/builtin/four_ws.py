@@ -3,7 +3,8 @@
 :func:`four_ws_robot` is also the building block for a 4WS variant in a package of its
 own: give it a :class:`~evorbc_ros.robots.four_ws.FourWSType` (which genes drive which
 wheel commands) and it fills in everything else from the 4WS robots' simulation, task,
-bridge, commands, settings and defaults (docs/your-robot.md).
+bridge adapters (family ``four_ws``), commands, settings and defaults
+(docs/your-robot.md).
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 
 from evorbc_ros.robots.four_ws import ROBOT_TYPES, FourWSType
-from evorbc_ros.robots.registry import Robot, SettingsFiles
+from evorbc_ros.robots.record import Robot, SettingsFiles
 
 #: Topics the 4WS command interface publishes: ros2_control forward command controllers.
 COMMAND_TOPICS = ("steering_position_controller/commands", "wheel_velocity_controller/commands")
@@ -47,9 +48,6 @@ def four_ws_robot(robot_type: FourWSType, description: str = "", **changes) -> R
         description=description or f"4WS robot with genes {', '.join(robot_type.parameter_names)}",
         parameters=robot_type.parameter_specs(geometry),
         settings=SETTINGS,
-        simulation="sim_bridge.robots.four_ws:simulated_robot",
-        task="offline_evolution.maze_task.factories:kinematic_task",
-        bridge="sim_bridge.bridge_robots:FourWSBridge",
         commands="evorbc_ros.nodes.wheel_commands:WheelCommands",
         command_topics=COMMAND_TOPICS,
         sensors="sensors/4ws.yaml",
@@ -57,6 +55,7 @@ def four_ws_robot(robot_type: FourWSType, description: str = "", **changes) -> R
         episode_time=120.0,  # s, paper Table I
         footprint_radius=geometry.footprint_radius,
         max_speed=geometry.max_speed,
+        family="four_ws",
         # The 4WS repertoire costs about 2M simulated seconds: 25 generations of
         # 150 genomes x 5 mazes x 120 s (paper Sec. IV-C).
         equal_budget_generations=25,

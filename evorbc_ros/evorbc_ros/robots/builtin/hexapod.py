@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from evorbc_ros.robots.hexapod import HEXAPOD, SPEED_BOUND, HexapodGeometry, parameter_specs
-from evorbc_ros.robots.registry import Robot, SettingsFiles
+from evorbc_ros.robots.record import Robot, SettingsFiles
 
 ROBOTS = (
     Robot(
@@ -16,9 +16,6 @@ ROBOTS = (
             neat="neat/hexapod.ini",
             task="tasks/maze-hexapod.yaml",
         ),
-        simulation="sim_bridge.robots.hexapod:simulated_robot",
-        task="offline_evolution.maze_task.factories:hexapod_task",
-        bridge="sim_bridge.bridge_robots:HexapodBridge",
         commands="evorbc_ros.nodes.trajectory_commands:JointTrajectoryCommands",
         command_topics=("joint_trajectory_controller/joint_trajectory",),
         sensors="sensors/hexapod.yaml",
@@ -26,6 +23,9 @@ ROBOTS = (
         episode_time=30.0,  # s, paper Table I (hexapod)
         footprint_radius=HexapodGeometry().footprint_radius,
         max_speed=SPEED_BOUND,
+        # Its simulation, bridge adapter, design check (the bridge simulates one design and
+        # one laser, docs/design.md section 11) and maze task are the family's.
+        family="hexapod",
         # Its repertoire's simulated time in generations of 150 x 30 s episodes
         # (paper Appendix E; docs/paper-check.md).
         equal_budget_generations=455,
@@ -36,8 +36,5 @@ ROBOTS = (
         # Trained in the paper's setting only (paper Table I); the shipped one from it with
         # starts anywhere in the maze (evorbc_ros/data/README.md, docs/generalisation.md).
         paper_arbitrator="hexapod-paper.arbitrator.json",
-        # The bridge simulates one design and one laser; a controller for another is
-        # refused with the first setting that differs (docs/design.md section 11).
-        design_check="sim_bridge.hexapod.design:check_controller",
     ),
 )

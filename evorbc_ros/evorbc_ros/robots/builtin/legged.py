@@ -1,13 +1,12 @@
 """Registering a legged robot from a URDF plus a settings file (docs/legged.md).
 
 :func:`legged_robot` turns a settings file (``config/robots/*.yaml``: URDF, gait, servos,
-physics, tilt limits) into a :class:`~evorbc_ros.robots.registry.Robot` whose factories are
-the generic legged ones: the simulation (:mod:`sim_bridge.legged.robot`), the maze task
-(:mod:`offline_evolution.maze_task.legged_task`), the bridge adapter
-(:mod:`sim_bridge.legged.bridge`), the joint-trajectory command interface
-(:mod:`evorbc_ros.nodes.legged_commands`) and the design check
-(:mod:`sim_bridge.legged.design`). The A1 (:mod:`.a1`) is one; a plugin registers its own
-robot the same way with an absolute settings path.
+physics, tilt limits) into a :class:`~evorbc_ros.robots.record.Robot` of the ``legged``
+family, whose simulation, maze task, bridge adapter and design check are the generic
+legged ones of the simulation's and the search's adapter tables, and whose onboard command
+interface is the joint-trajectory one (:mod:`evorbc_ros.nodes.legged_commands`). The A1
+(:mod:`.a1`) is one; a plugin registers its own robot the same way with an absolute
+settings path.
 
 Like every registration module this reads YAML only (numpy and PyYAML), so onboard nodes
 look a legged robot up without loading PyBullet.
@@ -22,7 +21,7 @@ from pathlib import Path
 
 from evorbc_ros.config import ConfigError, config_dir, load_yaml_mapping
 from evorbc_ros.robots.legged import Gait, gait_from_settings
-from evorbc_ros.robots.registry import Robot, SettingsFiles
+from evorbc_ros.robots.record import Robot, SettingsFiles
 
 
 @functools.lru_cache(maxsize=16)
@@ -117,9 +116,6 @@ def legged_robot(settings_file: str, description: str, **changes) -> Robot:
             neat=f"neat/{name}.ini",
             task=f"tasks/maze-{name}.yaml",
         ),
-        simulation="sim_bridge.legged.robot:simulated_robot",
-        task="offline_evolution.maze_task.legged_task:legged_task",
-        bridge="sim_bridge.legged.bridge:LeggedBridge",
         commands="evorbc_ros.nodes.legged_commands:LeggedTrajectoryCommands",
         command_topics=("joint_trajectory_controller/joint_trajectory",),
         sensors=f"sensors/{name}.yaml",
@@ -128,7 +124,7 @@ def legged_robot(settings_file: str, description: str, **changes) -> Robot:
         footprint_radius=model.footprint_radius,
         max_speed=model.speed_bound,
         episode_bytes=16_000,
-        design_check="sim_bridge.legged.design:check_controller",
+        family="legged",
         model=model,
     )
     return dataclasses.replace(robot, **changes) if changes else robot
