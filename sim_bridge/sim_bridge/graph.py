@@ -158,12 +158,9 @@ def trained_episode_time(arbitrator: str) -> float | None:
     as offline (``replay`` and ``evaluate`` use the file's task). None for a file that
     records none, or that cannot be read: the arbitrator node reports a bad file itself.
     """
-    if not arbitrator:
-        return None
     try:
-        with open(arbitrator, encoding="utf-8") as f:
-            value = json.load(f)["evolution"]["task"]["episode_time"]
-    except (OSError, ValueError, KeyError, TypeError):
+        value = _recorded(arbitrator)["evolution"]["task"]["episode_time"]
+    except (KeyError, TypeError):
         return None
     if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
         return None
@@ -176,15 +173,23 @@ def rangefinder_reach(arbitrator: str) -> float | None:
     Its sensor layout's mount radius plus range, or None for a file that records no
     rangefinders or cannot be read (the nodes report a bad file themselves).
     """
-    if not arbitrator:
-        return None
     try:
-        with open(arbitrator, encoding="utf-8") as f:
-            rangefinders = json.load(f)["sensors"]["rangefinders"]
+        rangefinders = _recorded(arbitrator)["sensors"]["rangefinders"]
         reach = float(rangefinders.get("mount_radius", 0.0)) + float(rangefinders["range"])
-    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+    except (KeyError, TypeError, ValueError, AttributeError):
         return None
     return reach if math.isfinite(reach) and reach > 0 else None
+
+
+def _recorded(arbitrator: str) -> dict:
+    """The JSON of the file ``arbitrator`` names; {} if none is named or it cannot be read."""
+    if not arbitrator:
+        return {}
+    try:
+        with open(arbitrator, encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return {}
 
 
 def laser_range(arbitrator: str) -> dict:
