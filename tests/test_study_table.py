@@ -2,7 +2,9 @@
 the report made from it is the report made from the results folder, and a malformed
 table is refused in one line naming the file and the key."""
 
+import base64
 import json
+import zlib
 
 import numpy as np
 import pytest
@@ -19,7 +21,7 @@ from offline_evolution.study.results import (
     load_results,
 )
 from offline_evolution.study.spec import load_study
-from offline_evolution.study.table import read_table, write_table
+from offline_evolution.study.table import pack_column, read_table, unpack_column, write_table
 
 #: The tiny study with every figure an EvoRBC study can draw, the selection heatmaps too.
 ALL_FIGURES = TINY_STUDY + "figures: [curves, boxplots, repertoires, selection]\n"
@@ -149,7 +151,7 @@ def _set(data, path: str, value):
     ("where", "value", "message"),
     [
         ("format", "csv", "format: expected 'evorbc-study-results', got 'csv'"),
-        ("version", 2, "version: expected 1, got 2"),
+        ("version", 1, "version: expected 2, got 1"),
         ("study", "metrics", "study: expected 'tiny' (the study asked for), got 'metrics'"),
         ("settings.0.id", "approach-standard", "settings[0].id: expected 'approach-evorbc'"),
         ("settings.0.runs.1.summary.best_fitness", "1.2",
@@ -157,9 +159,11 @@ def _set(data, path: str, value):
         ("settings.0.runs.0.seed", _set, "settings[0].runs[0].seed: missing"),
         ("settings.0.runs.0.best_so_far.at", [0, 5, 3],
          "settings[0].runs[0].best_so_far.at: expected increasing generations"),
-        ("settings.0.example.quality", [1, 2], "settings[0].example.quality: expected 5 values"),
-        ("settings.0.example.x", [0.5, 1, 2, 3, 4],
-         "settings[0].example.x: expected a list of integers"),
+        ("settings.0.example.quality", pack_column([1, 2]),
+         "settings[0].example.quality: expected 5 integers packed as base64 of zlib int32"),
+        ("settings.0.example.x", [1, 2, 3, 4, 5], "settings[0].example.x: expected str"),
+        ("settings.0.example.y", "not base64!", "settings[0].example.y: expected 5 integers"),
+        ("settings.0.example.count", -1, "settings[0].example.count: expected 0 to 1000000"),
         ("settings.0.selection.chosen", [[1, 2], [3, 4]],
          "settings[0].selection.chosen: expected 40 x 40 counts >= 0"),
         ("settings", {}, "settings: expected list, got {}"),
@@ -188,3 +192,15 @@ def test_replay_runs_belong_to_compact_not_to_a_table(tmp_path, capsys):
     code = study_main(["report", str(tmp_path / "tiny.yaml"), "--results", str(path),
                        "--replay-runs", "1", "--out", str(tmp_path / "out")])  # fmt: skip
     assert code == 1 and "evorbc-study compact --replay-runs" in capsys.readouterr().err
+
+
+def test_a_packed_column_inflates_no_more_than_its_count():
+    """A hostile column (a zlib bomb, trailing bytes, another count) is refused, not inflated."""
+    values = [-(2**31), -1, 0, 7, 2**31 - 1]
+    assert unpack_column(pack_column(values), 5).tolist() == values
+    bomb = base64.b64encode(zlib.compress(bytes(400_000_000), 9)).decode()
+    assert unpack_column(bomb, 5) is None
+    assert unpack_column(pack_column(values), 4) is None
+    assert unpack_column(pack_column(values) + "AAAA", 5) is None
+    with pytest.raises(ValueError):
+        pack_column([2**31])

@@ -14,16 +14,17 @@ from PIL import Image
 from evorbc_ros.atomic_io import atomic_path
 
 #: Colours of a PNG written by :func:`save_figure`. The figures are line plots and maze
-#: drawings in a few colours plus their anti-aliasing: 256 palette colours look the same
-#: as 24-bit RGB and take about a third of the bytes (docs/results/README.md, "Figures").
-PALETTE_COLOURS = 256
+#: drawings in a few colours plus their anti-aliasing: 64 palette colours look the same
+#: as 24-bit RGB (a colour bar shows steps of 1/64 of its range) and take about a quarter
+#: of the bytes; 256 took a third (docs/results/README.md, "Figures").
+PALETTE_COLOURS = 64
 #: dpi of the 16-inch-wide figures (a grid of 50 mazes, a grid of example repertoires):
 #: 1440 px wide reads as well as 2400 on a page, in a third of the bytes (issue 40).
 FIGURE_DPI = 90
 
 
 def shrink_png(path: str | os.PathLike) -> None:
-    """Rewrite the PNG at ``path`` in place with a 256-colour palette (atomically)."""
+    """Rewrite the PNG at ``path`` in place with :data:`PALETTE_COLOURS` colours (atomically)."""
     with Image.open(path) as im:
         small = im.convert("RGB").quantize(PALETTE_COLOURS)
     with atomic_path(path) as tmp:
