@@ -8,8 +8,9 @@ import pytest
 from study_helpers import write_tiny_study
 
 from offline_evolution.study.figures import bin_time_grid
+from offline_evolution.study.folder import finished_runs
 from offline_evolution.study.progress import StudyProgress, format_duration
-from offline_evolution.study.results import RunResult, SettingResults, finished_runs
+from offline_evolution.study.results import RunResult, SettingResults
 from offline_evolution.study.selection import aggregate_selection
 from offline_evolution.study.spec import Run, load_study
 

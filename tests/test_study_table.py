@@ -11,6 +11,7 @@ import pytest
 from study_helpers import TINY_STUDY, run_study
 
 from offline_evolution.study.cli import main as study_main
+from offline_evolution.study.folder import load_results
 from offline_evolution.study.results import (
     CHOSEN_BINS,
     OUTPUT_BINS,
@@ -18,7 +19,6 @@ from offline_evolution.study.results import (
     RunResult,
     SelectionCounts,
     SettingResults,
-    load_results,
 )
 from offline_evolution.study.spec import load_study
 from offline_evolution.study.table import pack_column, read_table, unpack_column, write_table

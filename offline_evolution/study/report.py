@@ -19,7 +19,8 @@ import numpy as np
 
 from evorbc_ros.atomic_io import atomic_write
 from offline_evolution.study import figures
-from offline_evolution.study.results import RunResult, SettingResults, load_results, protocol
+from offline_evolution.study.folder import load_results
+from offline_evolution.study.results import RunResult, SettingResults, protocol
 from offline_evolution.study.spec import Study
 from offline_evolution.study.stats import ALPHA, ClaimResult, evaluate_claims
 

@@ -1,17 +1,16 @@
-"""A study's results as the report reads them, and how they are read from a results folder.
+"""A study's results as the report reads them.
 
 The report and its figures need, per setting: each run's record (seed, generations, times,
 summary) and per-generation highest fitness so far, the first run's repertoire as the
 figure draws it (:class:`ExampleRepertoire`), and, for the selection heatmaps, the pooled
-replay counts (:class:`SelectionCounts`). :func:`load_results` reads them from a results
-folder; ``offline_evolution/study/table.py`` writes and reads them as one compact file
-(docs/study.md, "Compact result tables"). The report is made from these objects alone, so
-a report from the folder and one from its table are the same.
+replay counts (:class:`SelectionCounts`). ``offline_evolution/study/folder.py`` reads
+them from a results folder; ``offline_evolution/study/table.py`` writes and reads them as
+one compact file (docs/study.md, "Compact result tables"). The report is made from these
+objects alone, so a report from the folder and one from its table are the same.
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -21,8 +20,7 @@ import numpy as np
 
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.study.run import RUN_FILE, read_json_xz
-from offline_evolution.study.spec import Study
+from offline_evolution.study.run import read_json_xz
 
 #: Units of the example repertoire's integer columns in a table (value = integer x unit):
 #: 0.1 mm is a fifth of a pixel in the repertoire figure's smallest panel (0.2 m over about
@@ -188,42 +186,6 @@ class SettingResults:
                 value = value.get(part) if isinstance(value, dict) else None
             out.append(np.nan if value is None else float(value))
         return np.array(out)
-
-
-def finished_runs(study: Study, results: Path) -> list[tuple[str, dict, list[FinishedRun]]]:
-    """``(setting id, values, finished runs in seed order)`` of every setting of ``study``."""
-    out = []
-    for sid, values in study.settings():
-        runs = [
-            FinishedRun(path.parent, json.loads(path.read_text(encoding="utf-8")))
-            for path in sorted((results / sid).glob(f"seed-*/{RUN_FILE}"))
-        ]
-        out.append((sid, values, runs))
-    return out
-
-
-def load_results(
-    study: Study, results: Path, selection: bool = False, replay_runs: int | None = None
-) -> list[SettingResults]:
-    """Every setting of ``study`` with the runs finished in ``results`` (seed order).
-
-    Args:
-        selection: replay the EvoRBC settings' controllers for the selection heatmaps.
-        replay_runs: at most this many runs per setting are replayed (default: all).
-    """
-    out = []
-    for sid, values, runs in finished_runs(study, results):
-        setting = SettingResults(sid, values, [RunResult.from_folder(r) for r in runs])
-        if runs:
-            repertoire = runs[0].repertoire()
-            if repertoire is not None:
-                setting.example = ExampleRepertoire.of(repertoire, setting.runs[0].seed)
-            if selection and values.get("approach", "evorbc") == "evorbc":
-                from offline_evolution.study.selection import selection_counts
-
-                setting.selection = selection_counts(runs[:replay_runs])
-        out.append(setting)
-    return out
 
 
 def protocol(settings: list[SettingResults]) -> dict:
