@@ -13,7 +13,10 @@ hot paths. This script measures, in fresh processes whose imports come from each
   120 s, the shipped repertoire, EvoRBC polar mapping), the compiled episode kernel;
 * hexapod primitives: evaluations/s of 2 s gaits in PyBullet on one worker;
 * hexapod episodes: control cycles/s of the paper-protocol hexapod controller's 30 s episode on
-  one worker.
+  one worker;
+* the onboard 10 Hz cycle: choices/s of the arbitrator node's pure part
+  (``evorbc_ros.arbitration.Controller.step``: network, mapping, nearest primitive) for each
+  shipped controller, on 2,000 recorded-like input vectors in [0, 1].
 
 The trees run in turn, A B B A A B ... (this machine drifts by 20 % from day to day, and
 other jobs come and go). Each round's two runs are next to each other in time, so the
@@ -41,6 +44,7 @@ FIGURES = {
     "4ws_episodes": "4WS episode kernel (control cycles/s)",
     "hexapod_primitives": "hexapod primitives (evaluations/s, 1 worker)",
     "hexapod_episodes": "hexapod episode (control cycles/s, 1 worker)",
+    "onboard_cycle": "onboard 10 Hz cycle, arbitrator node's compute (choices/s)",
 }
 
 
@@ -86,7 +90,31 @@ def measure(wanted: set[str]) -> dict:
         hexapod.close()
     if "hexapod_episodes" in wanted:
         out["hexapod_episodes"] = hexapod_episodes()
+    if "onboard_cycle" in wanted:
+        out["onboard_cycle"] = onboard_cycle()
     return out
+
+
+def onboard_cycle() -> float:
+    """Choices/s of ``Controller.step`` over the shipped controllers (harmonic mean)."""
+    import numpy as np
+
+    from evorbc_ros.arbitration import Controller
+    from evorbc_ros.defaults import default_arbitrator
+
+    rates = []
+    for robot in ("4ws-5", "hexapod", "a1"):
+        controller = Controller(str(default_arbitrator(robot)))
+        n = controller.spec.sensors.n_inputs
+        inputs = np.random.default_rng(2).uniform(0.0, 1.0, (2000, n))
+
+        def cycles(c=controller, x=inputs):
+            c.reset()
+            for row in x:
+                c.step(row)
+
+        rates.append(best_rate(cycles, len(inputs), 5))
+    return len(rates) / sum(1.0 / r for r in rates)
 
 
 def four_ws_episodes() -> float:
