@@ -6,7 +6,7 @@ the hexapod):
 * the **maze setup** of a generation's draw of K generated mazes: generating and proving
   them (the clearance-aware path search; median of ``--draws`` draws);
 * the **world build** in a worker: a new maze's first episode against the same episode
-  again, its simulation kept (``sim_bridge/maze_sims.py``); the difference is loading the
+  again, its simulation kept (``sim_bridge/legged/maze_sims.py``); the difference is loading the
   maze's walls into PyBullet, paid once per maze and worker;
 * the **cost of a generation** of arbitrator evolution with the shipped repertoire and
   NEAT settings, on the paper protocol (its own maze, one random start a genome) and with

@@ -162,7 +162,7 @@ def robots():
     old = four_ws_robot(
         dataclasses.replace(ROBOT_TYPES["4ws-5"], name="oldtracks"),
         family="",
-        simulation="sim_bridge.robots.four_ws:simulated_robot",
+        simulation="sim_bridge.four_ws.robot:simulated_robot",
         task="offline_evolution.maze_task.factories:kinematic_task",
         bridge="sim_bridge.bridge_robots:FourWSBridge",
     )
@@ -174,7 +174,7 @@ TRACKS_SIM = '''\
 from sim_bridge.robots.adapters import SimAdapters
 
 ADAPTERS = SimAdapters(
-    simulation="sim_bridge.robots.four_ws:simulated_robot",
+    simulation="sim_bridge.four_ws.robot:simulated_robot",
     bridge="sim_bridge.bridge_robots:FourWSBridge",
 )
 '''

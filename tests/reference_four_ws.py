@@ -1,7 +1,7 @@
 """Plain-Python reference of the 4WS motion model (docs/design.md section 2).
 
 Written from the specification alone, for clarity rather than speed, to cross-check the
-compiled model in ``sim_bridge.four_ws_motion``. Body frame: x forward, y left, angles
+compiled model in ``sim_bridge.four_ws.motion``. Body frame: x forward, y left, angles
 counter-clockwise. All quantities in SI units (m, s, rad, m/s).
 
 Besides the motion itself, each step records its *margins*: how far the inputs were from every

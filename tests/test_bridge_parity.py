@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from evorbc_ros.robots.four_ws import FourWSGeometry
-from sim_bridge.four_ws_motion import STATE_SIZE, motion_limits, step_robot
+from sim_bridge.four_ws.motion import STATE_SIZE, motion_limits, step_robot
 from sim_bridge.geometry import cast_ray
 from sim_bridge.maze import load_named_maze, maze_names
 from sim_bridge.world import SimWorld

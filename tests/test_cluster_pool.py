@@ -15,7 +15,7 @@ from ray_cluster import LocalCluster, free_port
 
 from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
 from offline_evolution.maze_task.task import MazeTaskSettings
-from sim_bridge.robots.hexapod import HexapodRobot
+from sim_bridge.hexapod.robot import HexapodRobot
 
 pytest.importorskip("ray")
 
@@ -25,7 +25,7 @@ EVAL_TIME = 2.0  # s
 # Runs in its own process, connected to the cluster through EVORBC_CLUSTER, as the CLI is.
 PRIMITIVES = f"""
 import sys, numpy as np
-from sim_bridge.robots.hexapod import HexapodRobot
+from sim_bridge.hexapod.robot import HexapodRobot
 genes = np.random.default_rng({GENES_SEED}).uniform(-1, 1, ({N_PRIMITIVES}, 37))
 robot = HexapodRobot(workers=int(sys.argv[2]) if len(sys.argv) > 2 else None)
 print("started", flush=True)

@@ -45,7 +45,7 @@ def test_the_burger_is_declared_by_its_settings_file_with_its_published_figures(
 
 def simulate(genes, seconds=2.0, **geometry):
     """``PrimitiveOutcome`` of the Burger (or the Burger with ``geometry`` changed)."""
-    from sim_bridge.robots.diff_drive import DiffDriveRobot
+    from sim_bridge.diff_drive.robot import DiffDriveRobot
 
     g = registry.lookup("turtlebot3-burger").model
     g = DiffDriveGeometry(**{**g.as_dict(), **geometry})

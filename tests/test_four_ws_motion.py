@@ -8,7 +8,7 @@ import pytest
 
 from evorbc_ros.robots.four_ws import FourWSGeometry
 from evorbc_ros.robots.registry import robot_type
-from sim_bridge.four_ws_motion import (
+from sim_bridge.four_ws.motion import (
     HEADING,
     SPEED,
     STATE_SIZE,

@@ -15,7 +15,7 @@ import pytest
 from reference_four_ws import Margins, State, reference_primitive, reference_step
 
 from evorbc_ros.robots.four_ws import FourWSGeometry
-from sim_bridge.four_ws_motion import STATE_SIZE, motion_limits, step_robot
+from sim_bridge.four_ws.motion import STATE_SIZE, motion_limits, step_robot
 from sim_bridge.geometry import wall_boxes
 from sim_bridge.kinematics import run_primitives
 

@@ -19,8 +19,8 @@ from sim_bridge.geometry import wall_boxes
 from sim_bridge.hexapod.evaluate import HEADING, SECONDS, TILT, X, Y, evaluate_genes
 from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings
 from sim_bridge.hexapod.pool import EvaluationPool
+from sim_bridge.hexapod.robot import DISCARD_TILT, HexapodRobot
 from sim_bridge.hexapod.scanner import Scanner
-from sim_bridge.robots.hexapod import DISCARD_TILT, HexapodRobot
 
 G = HexapodGeometry()
 

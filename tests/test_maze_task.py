@@ -17,7 +17,7 @@ from offline_evolution.maze_task.task import (
     evorbc_controller,
     standard_controller,
 )
-from sim_bridge.four_ws_motion import STATE_SIZE, speed_through_wheels, step_robot
+from sim_bridge.four_ws.motion import STATE_SIZE, speed_through_wheels, step_robot
 from sim_bridge.sensors import read_sensors
 
 CORRIDOR = {

@@ -143,7 +143,7 @@ def test_the_kernel_reads_motion_as_the_onboard_code_does_cycle_by_cycle(motion_
     """Offline choices of a controller that uses the motion input are those of the onboard
     arbitrator fed by the radar node's code (MotionWindow stamped as the bridge stamps), and
     the input matters: without its connection the episode differs."""
-    from sim_bridge.four_ws_motion import STATE_SIZE, speed_through_wheels, step_robot
+    from sim_bridge.four_ws.motion import STATE_SIZE, speed_through_wheels, step_robot
     from sim_bridge.sensors import read_sensors
 
     task = motion_task

@@ -241,7 +241,7 @@ def test_offline_replay_stands_still_and_counts_the_stopped_cycles(task, edit):
 def test_the_kernel_stops_like_the_onboard_controller_cycle_by_cycle(task):
     """A network that drives, then stops near a wall: the compiled kernel and the onboard
     controller (pure Python) choose the same, no-primitive cycles included."""
-    from sim_bridge.four_ws_motion import STATE_SIZE, speed_through_wheels, step_robot
+    from sim_bridge.four_ws.motion import STATE_SIZE, speed_through_wheels, step_robot
     from sim_bridge.sensors import read_sensors
 
     arb = edited(ARB, stop_near_walls)

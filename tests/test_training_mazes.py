@@ -281,7 +281,7 @@ class _FakeSim:
 
 
 def test_a_worker_keeps_a_few_generated_mazes_simulations():
-    from sim_bridge.maze_sims import KEEP, MazeSims
+    from sim_bridge.legged.maze_sims import KEEP, MazeSims
 
     spec = spec_for_robot("4ws-5")
     own = [generate_maze(spec, 7, 0).maze]

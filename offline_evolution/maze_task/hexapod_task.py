@@ -13,7 +13,7 @@ from evorbc_ros.robots.hexapod import HexapodGeometry
 from offline_evolution.maze_task.base import MazeTaskSettings
 from offline_evolution.maze_task.legged_task import LeggedMazeTask
 from sim_bridge.hexapod.physics import PhysicsSettings, hexapod_robot_settings
-from sim_bridge.robots.hexapod import describe_simulation
+from sim_bridge.hexapod.robot import describe_simulation
 
 
 class HexapodMazeTask(LeggedMazeTask):

@@ -37,7 +37,7 @@ import numpy as np
 
 from evorbc_ros import mapping as onboard_mapping
 from offline_evolution.arbitrator.compiled import activate, activate_recurrent
-from sim_bridge.four_ws_motion import HEADING, STATE_SIZE, X, Y, speed_through_wheels
+from sim_bridge.four_ws.motion import HEADING, STATE_SIZE, X, Y, speed_through_wheels
 from sim_bridge.geometry import grid_candidates
 from sim_bridge.kinematics import halt, step_model
 from sim_bridge.sensors import read_sensors
@@ -296,8 +296,8 @@ def run_episodes(
         world: :class:`~offline_evolution.maze_task.world.MazePack`.
         sensors: :class:`~sim_bridge.sensors.CompiledLayout`.
         controller: :class:`~offline_evolution.maze_task.task.ControllerArrays`.
-        lim: the robot's limits: :class:`~sim_bridge.four_ws_motion.MotionLimits` or
-            :class:`~sim_bridge.diff_drive_motion.DiffLimits` (its state fits in
+        lim: the robot's limits: :class:`~sim_bridge.four_ws.motion.MotionLimits` or
+            :class:`~sim_bridge.diff_drive.motion.DiffLimits` (its state fits in
             ``STATE_SIZE`` columns, x, y and heading first).
         traces: :class:`Traces`, filled when ``traces.on``.
         draws: :class:`WorldDraws`, applied when ``draws.on``.

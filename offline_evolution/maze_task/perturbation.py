@@ -7,7 +7,7 @@ and a maze task applies those its simulation has, which it lists in its
 ``perturbations_applied`` (:data:`KINEMATIC`, :data:`PYBULLET_LEGGED`; a plugin's task
 lists its own):
 
-* the 4WS robots' kinematic model (``sim_bridge/four_ws_motion.py``) has no friction, mass
+* the 4WS robots' kinematic model (``sim_bridge/four_ws/motion.py``) has no friction, mass
   or servos; it takes the wheel speed gain, the latency, the rangefinder noise and
   dropouts and the start pose, inside the compiled kernel;
 * the legged robots (PyBullet: the hexapod, the A1, any from a settings file,

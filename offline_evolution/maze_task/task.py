@@ -36,8 +36,8 @@ from offline_evolution.maze_task.kernel import (
 from offline_evolution.maze_task.perturbation import KINEMATIC
 from offline_evolution.maze_task.world import MazePiece, combine_pieces, maze_piece
 from offline_evolution.task_protocol import EpisodeResult
-from sim_bridge.robots.diff_drive import DiffDriveRobot
-from sim_bridge.robots.four_ws import FourWSRobot
+from sim_bridge.diff_drive.robot import DiffDriveRobot
+from sim_bridge.four_ws.robot import FourWSRobot
 from sim_bridge.sensors import compile_layout
 
 #: A robot whose compiled motion model the episode kernel runs.
@@ -132,8 +132,8 @@ class MazeTask(MazeTaskBase):
     Args:
         settings: the task.
         robot: a registered robot's name, or its simulated robot (a
-            :class:`~sim_bridge.robots.four_ws.FourWSRobot` or
-            :class:`~sim_bridge.robots.diff_drive.DiffDriveRobot`: their compiled motion
+            :class:`~sim_bridge.four_ws.robot.FourWSRobot` or
+            :class:`~sim_bridge.diff_drive.robot.DiffDriveRobot`: their compiled motion
             model runs in the kernel).
 
     """

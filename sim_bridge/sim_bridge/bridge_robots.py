@@ -1,6 +1,6 @@
 """The robot-specific half of the simulation bridge: a 4WS robot, or a legged one.
 
-A differential-drive robot's is :mod:`sim_bridge.diff_drive_bridge`. The legged adapters
+A differential-drive robot's is :mod:`sim_bridge.diff_drive.bridge`. The legged adapters
 are :class:`HexapodBridge` and, for any legged robot from a settings file,
 :mod:`sim_bridge.legged.bridge`; both are :class:`TrajectoryBridge`. Each adapter
 owns its simulated world, subscribes its command topics, fills the joint states and laser

@@ -2,8 +2,8 @@
 
 The episode kernel (:mod:`offline_evolution.maze_task.kernel`) runs whichever kinematic
 robot its task has: :func:`step_model` and :func:`halt` resolve at compile time, from the
-limits' NamedTuple type, to the 4WS model (:class:`~sim_bridge.four_ws_motion.MotionLimits`)
-or the differential-drive one (:class:`~sim_bridge.diff_drive_motion.DiffLimits`). numba
+limits' NamedTuple type, to the 4WS model (:class:`~sim_bridge.four_ws.motion.MotionLimits`)
+or the differential-drive one (:class:`~sim_bridge.diff_drive.motion.DiffLimits`). numba
 compiles one kernel per model, so neither pays for the other: no branch runs per step
 (docs/design.md section 19).
 """
@@ -15,8 +15,8 @@ import numpy as np
 from numba import types
 from numba.extending import overload
 
-from sim_bridge.diff_drive_motion import DiffLimits, step_diff
-from sim_bridge.four_ws_motion import HEADING, STATE_SIZE, MotionLimits, X, Y, step_robot
+from sim_bridge.diff_drive.motion import DiffLimits, step_diff
+from sim_bridge.four_ws.motion import HEADING, STATE_SIZE, MotionLimits, X, Y, step_robot
 
 
 def step_model(state, i, command, lim, boxes, candidates):
@@ -83,8 +83,8 @@ def run_model_primitives(commands, n_steps, lim):
         commands: ``(n, w)`` commands of the model (4WS: ``(n, 5)`` wheel commands;
             differential drive: ``(n, 2)`` body twists).
         n_steps: number of control steps (T / dt).
-        lim: :class:`~sim_bridge.four_ws_motion.MotionLimits` or
-            :class:`~sim_bridge.diff_drive_motion.DiffLimits`.
+        lim: :class:`~sim_bridge.four_ws.motion.MotionLimits` or
+            :class:`~sim_bridge.diff_drive.motion.DiffLimits`.
 
     Returns:
         ``(n, 4)`` rows ``(x m, y m, final heading rad (unwrapped), path length m)``.
@@ -108,6 +108,6 @@ def run_model_primitives(commands, n_steps, lim):
 
 
 #: The 4WS robots' name for :func:`run_model_primitives` (``(n, 5)`` wheel commands and
-#: :class:`~sim_bridge.four_ws_motion.MotionLimits`). It lives here, not beside the 4WS
+#: :class:`~sim_bridge.four_ws.motion.MotionLimits`). It lives here, not beside the 4WS
 #: model, because this module imports the model: one direction only.
 run_primitives = run_model_primitives

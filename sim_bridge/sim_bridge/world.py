@@ -1,7 +1,7 @@
 """The simulated world of the bridge: a 4WS robot in a maze, one control step at a time.
 
 The robot moves by the same compiled motion model as offline evolution
-(:func:`sim_bridge.four_ws_motion.step_robot`); wall contact and the laser's rays are
+(:func:`sim_bridge.four_ws.motion.step_robot`); wall contact and the laser's rays are
 computed by PyBullet (:class:`sim_bridge.pybullet_world.PyBulletMaze`). The contact rule is
 the offline one: if the footprint would overlap a wall after a step, the position stays
 and the heading change is kept.
@@ -16,7 +16,7 @@ import numpy as np
 
 from evorbc_ros.robots.four_ws import FourWSGeometry
 from evorbc_ros.robots.registry import robot_type
-from sim_bridge.four_ws_motion import (
+from sim_bridge.four_ws.motion import (
     ANGLE_FL,
     HEADING,
     SPEED,
@@ -80,7 +80,7 @@ class EpisodeStatus:
 class SimWorld:
     """A 4WS robot in a maze, stepped by wheel commands.
 
-    :class:`~sim_bridge.diff_drive_world.DiffDriveWorld` changes the motion model only
+    :class:`~sim_bridge.diff_drive.world.DiffDriveWorld` changes the motion model only
     (:meth:`_model`, :meth:`_move`, :meth:`_roll_wheels`).
     """
 

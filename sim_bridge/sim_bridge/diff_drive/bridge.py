@@ -19,7 +19,7 @@ from sensor_msgs.msg import JointState
 from evorbc_ros.nodes.common import RELIABLE, robot_named
 from evorbc_ros.robots.diff_drive import WHEEL_JOINTS
 from sim_bridge.bridge_robots import KinematicBridge
-from sim_bridge.diff_drive_world import DiffDriveWorld
+from sim_bridge.diff_drive.world import DiffDriveWorld
 
 
 class DiffDriveBridge(KinematicBridge):

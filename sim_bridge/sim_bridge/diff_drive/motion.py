@@ -1,6 +1,6 @@
 """The differential-drive motion model, compiled with numba and batched.
 
-The counterpart of :mod:`sim_bridge.four_ws_motion` for a differential-drive robot
+The counterpart of :mod:`sim_bridge.four_ws.motion` for a differential-drive robot
 (docs/design.md section 19): repertoire generation, the maze task's episode kernel and the
 simulation bridge all step it with :func:`step_diff`.
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from evorbc_ros.robots.diff_drive import DiffDriveGeometry
 from evorbc_ros.robots.primitive import ParameterSpec
-from sim_bridge.diff_drive_motion import diff_limits
+from sim_bridge.diff_drive.motion import diff_limits
 from sim_bridge.kinematics import run_model_primitives
 from sim_bridge.robots.base import PrimitiveOutcome, control_steps
 

@@ -1,7 +1,7 @@
 """The bridge's world for a differential-drive robot.
 
 The 4WS world's maze, walls, laser and episode, with the differential-drive motion model
-(:mod:`sim_bridge.diff_drive_motion`).
+(:mod:`sim_bridge.diff_drive.motion`).
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from evorbc_ros.robots.registry import lookup
-from sim_bridge.diff_drive_motion import OMEGA, STATE_SIZE, V, body_twist, diff_limits, step_diff
+from sim_bridge.diff_drive.motion import OMEGA, STATE_SIZE, V, body_twist, diff_limits, step_diff
 from sim_bridge.world import SimWorld
 
 _NO_BOXES = np.empty((0, 6))

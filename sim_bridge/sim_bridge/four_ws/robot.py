@@ -7,7 +7,7 @@ import numpy as np
 from evorbc_ros.robots.four_ws import FourWSGeometry, FourWSType
 from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.robots.registry import robot_type
-from sim_bridge.four_ws_motion import motion_limits
+from sim_bridge.four_ws.motion import motion_limits
 from sim_bridge.kinematics import run_primitives
 from sim_bridge.robots.base import PrimitiveOutcome, control_steps
 

@@ -12,8 +12,8 @@ from evorbc_ros.robots.hexapod import HexapodGeometry
 from evorbc_ros.sensors import SensorLayout
 from sim_bridge.hexapod.maze_world import DEFAULT_SENSORS
 from sim_bridge.hexapod.physics import PhysicsSettings
+from sim_bridge.hexapod.robot import describe_simulation
 from sim_bridge.robots.design import check_controller_simulation
-from sim_bridge.robots.hexapod import describe_simulation
 
 
 def check_controller(robot, controller) -> None:

@@ -42,12 +42,12 @@ from evorbc_ros.mapping import NO_PRIMITIVE, MappingFunction, PrimitiveLookup, c
 from evorbc_ros.network import NetworkSpec
 from evorbc_ros.robots.legged import LeggedGaitTable, gait_step_times
 from evorbc_ros.sensors import SensorLayout
+from sim_bridge.legged.maze_sims import MazeSims
 from sim_bridge.legged.perturbed import perturbed_ranges, perturbed_sim
 from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.legged.scanner import Scanner
 from sim_bridge.legged.settings import LeggedRobotSettings
 from sim_bridge.maze import Maze
-from sim_bridge.maze_sims import MazeSims
 
 
 @dataclass(frozen=True)

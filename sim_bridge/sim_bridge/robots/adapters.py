@@ -44,14 +44,14 @@ class SimAdapters:
 #: The families evorbc simulates.
 BUILTIN = {
     "four_ws": SimAdapters(
-        "sim_bridge.robots.four_ws:simulated_robot", "sim_bridge.bridge_robots:FourWSBridge"
+        "sim_bridge.four_ws.robot:simulated_robot", "sim_bridge.bridge_robots:FourWSBridge"
     ),
     "diff_drive": SimAdapters(
-        "sim_bridge.robots.diff_drive:simulated_robot",
-        "sim_bridge.diff_drive_bridge:DiffDriveBridge",
+        "sim_bridge.diff_drive.robot:simulated_robot",
+        "sim_bridge.diff_drive.bridge:DiffDriveBridge",
     ),
     "hexapod": SimAdapters(
-        "sim_bridge.robots.hexapod:simulated_robot",
+        "sim_bridge.hexapod.robot:simulated_robot",
         "sim_bridge.bridge_robots:HexapodBridge",
         "sim_bridge.hexapod.design:check_controller",
     ),
