@@ -164,7 +164,7 @@ def robots():
         family="",
         simulation="sim_bridge.four_ws.robot:simulated_robot",
         task="offline_evolution.maze_task.factories:kinematic_task",
-        bridge="sim_bridge.bridge_robots:FourWSBridge",
+        bridge="sim_bridge.four_ws.bridge:FourWSBridge",
     )
     return [new, old]
 '''
@@ -175,7 +175,7 @@ from sim_bridge.robots.adapters import SimAdapters
 
 ADAPTERS = SimAdapters(
     simulation="sim_bridge.four_ws.robot:simulated_robot",
-    bridge="sim_bridge.bridge_robots:FourWSBridge",
+    bridge="sim_bridge.four_ws.bridge:FourWSBridge",
 )
 '''
 TRACKS_SEARCH = '''\

@@ -7,9 +7,9 @@ import pytest
 
 from evorbc_ros.robots.four_ws import FourWSGeometry
 from sim_bridge.four_ws.motion import STATE_SIZE, motion_limits, step_robot
+from sim_bridge.four_ws.world import FourWSWorld
 from sim_bridge.geometry import cast_ray
 from sim_bridge.maze import load_named_maze, maze_names
-from sim_bridge.world import SimWorld
 
 LIM = motion_limits(FourWSGeometry())
 SENSOR_ANGLES = np.radians([0, 60, 120, 180, 240, 300])
@@ -18,7 +18,7 @@ SENSOR_ANGLES = np.radians([0, 60, 120, 180, 240, 300])
 @pytest.mark.parametrize("name", maze_names())
 def test_same_commands_same_trajectory_and_ranges_for_1200_cycles(name):
     maze = load_named_maze(name)
-    world = SimWorld(maze, "4ws-5")
+    world = FourWSWorld(maze, "4ws-5")
     offline = np.zeros((1, STATE_SIZE))
     offline[0, :3] = maze.start_pose
     every = np.arange(len(maze.boxes), dtype=np.int64)

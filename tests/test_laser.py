@@ -8,9 +8,10 @@ import pytest
 from evorbc_ros.config import config_dir
 from evorbc_ros.laser import InputError, LaserPose, LaserToRangefinders
 from evorbc_ros.sensors import SensorLayout
+from sim_bridge.four_ws.world import FourWSWorld
 from sim_bridge.maze import load_named_maze
 from sim_bridge.sensors import compile_layout, read_sensors
-from sim_bridge.world import LaserConfig, SimWorld
+from sim_bridge.world import LaserConfig
 
 LAYOUT = SensorLayout.load(config_dir() / "sensors" / "4ws.yaml")
 RF = LAYOUT.rangefinders  # six rays at 0, 60, ..., 300 deg, 1 m from a 0.05 m mount radius
@@ -173,7 +174,7 @@ def test_simulated_laser_gives_the_offline_readings():
     # The bridge's laser (PyBullet rays from the centre, sent as float32 like a real
     # LaserScan) through the laser node's code equals the offline sensors within 0.1 mm.
     maze = load_named_maze("obstacle")
-    world = SimWorld(maze, laser=LaserConfig())
+    world = FourWSWorld(maze, "4ws-5", laser=LaserConfig())
     c = compile_layout(LAYOUT)
     converter = LaserToRangefinders(RF)
     out = np.empty(c.n_inputs)

@@ -10,9 +10,10 @@ import pytest
 from evorbc_ros.config import config_dir
 from evorbc_ros.laser import InputError, LaserToRangefinders, beam_tolerance, check_beam_count
 from evorbc_ros.sensors import SensorLayout
+from sim_bridge.four_ws.world import FourWSWorld
 from sim_bridge.hexapod.scanner import Scanner
 from sim_bridge.maze import load_named_maze
-from sim_bridge.world import LaserConfig, SimWorld
+from sim_bridge.world import LaserConfig
 
 RF = SensorLayout.load(config_dir() / "sensors" / "4ws.yaml").rangefinders
 HEXAPOD = SensorLayout.load(config_dir() / "sensors" / "hexapod.yaml").rangefinders
@@ -34,7 +35,7 @@ def read(ranges, range_min=0.0, layout=RF, angle_min=BEAMS[0], inc=DEG):
 def maze_scans():
     """Clean scans of the bridge's 360-beam laser from 40 poses in the obstacle maze."""
     maze = load_named_maze("obstacle")
-    world = SimWorld(maze, laser=LaserConfig())
+    world = FourWSWorld(maze, "4ws-5", laser=LaserConfig())
     try:
         scans = []
         for x, y, h in maze.sample_starts(np.random.default_rng(1), 40, 0.05):

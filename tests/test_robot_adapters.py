@@ -62,7 +62,8 @@ def tracks(tmp_path, monkeypatch):
 
 def test_a_plugin_declares_its_record_and_each_layers_adapters_in_their_own_groups(tracks, capsys):
     from offline_evolution.maze_task.task import MazeTaskSettings, make_task
-    from sim_bridge.bridge_robots import FourWSBridge, bridge_robot_class
+    from sim_bridge.bridge_robots import bridge_robot_class
+    from sim_bridge.four_ws.bridge import FourWSBridge
 
     robot = registry.lookup("tracks")
     assert robot.family == "tracked" and robot.legacy_factories == {}

@@ -132,7 +132,7 @@ def test_bridge_skips_malformed_trajectories_and_holds_the_last_targets():
 
             return Log()
 
-    from sim_bridge.bridge_robots import HexapodBridge
+    from sim_bridge.hexapod.bridge import HexapodBridge
     from sim_bridge.maze import load_named_maze
 
     node = Node()

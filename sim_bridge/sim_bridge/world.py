@@ -1,10 +1,12 @@
-"""The simulated world of the bridge: a 4WS robot in a maze, one control step at a time.
+"""The simulated world of the bridge: a kinematic robot in a maze, one control step at a time.
 
-The robot moves by the same compiled motion model as offline evolution
-(:func:`sim_bridge.four_ws.motion.step_robot`); wall contact and the laser's rays are
+The robot moves by its family's compiled motion model, the one offline evolution steps
+(:class:`~sim_bridge.four_ws.world.FourWSWorld`,
+:class:`~sim_bridge.diff_drive.world.DiffDriveWorld`); wall contact and the laser's rays are
 computed by PyBullet (:class:`sim_bridge.pybullet_world.PyBulletMaze`). The contact rule is
 the offline one: if the footprint would overlap a wall after a step, the position stays
-and the heading change is kept.
+and the heading change is kept. The episode's status (:class:`EpisodeStatus`) is every
+robot's, the legged ones' too.
 """
 
 from __future__ import annotations
@@ -14,23 +16,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from evorbc_ros.robots.four_ws import FourWSGeometry
-from evorbc_ros.robots.registry import robot_type
-from sim_bridge.four_ws.motion import (
-    ANGLE_FL,
-    HEADING,
-    SPEED,
-    STATE_SIZE,
-    X,
-    Y,
-    motion_limits,
-    step_robot,
-)
 from sim_bridge.maze import Maze
 from sim_bridge.pybullet_world import PyBulletMaze
 
-_NO_BOXES = np.empty((0, 6))
-_NO_CANDIDATES = np.empty(0, dtype=np.int64)
+#: Columns of a kinematic robot's state row that every motion model shares (m, m, rad;
+#: :mod:`sim_bridge.four_ws.motion`, :mod:`sim_bridge.diff_drive.motion`).
+X, Y, HEADING = 0, 1, 2
 
 
 @dataclass(frozen=True)
@@ -77,22 +68,33 @@ class EpisodeStatus:
         return 1.0 - self.distance / self.initial_distance if self.initial_distance > 0 else 0.0
 
 
-class SimWorld:
-    """A 4WS robot in a maze, stepped by wheel commands.
+class KinematicWorld:
+    """A kinematic robot in a maze, stepped by its motion model's commands.
 
-    :class:`~sim_bridge.diff_drive.world.DiffDriveWorld` changes the motion model only
-    (:meth:`_model`, :meth:`_move`, :meth:`_roll_wheels`).
+    A family's world gives the motion model (:meth:`_model`, :meth:`_move`,
+    :meth:`_roll_wheels`): :class:`~sim_bridge.four_ws.world.FourWSWorld`,
+    :class:`~sim_bridge.diff_drive.world.DiffDriveWorld`.
+
+    Args:
+        maze: the maze.
+        robot: a registered robot of the world's family.
+        start: ``(x m, y m, heading rad)``; None: the maze's start pose.
+        episode_time: s, T of eq. 5.
+        laser: the simulated scanner.
+        gui: open PyBullet's GUI.
+        geometry: replaces the robot's body (its family's geometry class).
+
     """
 
     def __init__(
         self,
         maze: Maze,
-        robot: str = "4ws-5",
+        robot: str,
         start=None,
         episode_time=120.0,
         laser: LaserConfig = LaserConfig(),
         gui: bool = False,
-        geometry: FourWSGeometry | None = None,
+        geometry=None,
     ) -> None:
         self.maze = maze
         self._model(robot, geometry)
@@ -111,20 +113,16 @@ class SimWorld:
         self.physics.show_pose(*self.pose)
 
     def _model(self, robot: str, geometry) -> None:
-        """The robot's motion model: its type, geometry and limits (4WS here)."""
-        self.type = robot_type(robot)
-        self.geometry = geometry or self.type.body()
-        self.limits = motion_limits(self.geometry)
-        self.state_size = STATE_SIZE
-        self.n_wheels = 4
+        """Set the robot's motion model: ``geometry``, ``limits``, ``state_size``, ``n_wheels``."""
+        raise NotImplementedError
 
     def _move(self, command: np.ndarray) -> float:
         """One control step of the motion model, no walls; the distance moved (m)."""
-        return step_robot(self.state, 0, command, self.limits, _NO_BOXES, _NO_CANDIDATES)
+        raise NotImplementedError
 
     def _roll_wheels(self, wheel_radius: float) -> None:
-        """Integrate the wheels' rotation (rad) over the step: one speed for all four."""
-        self.wheel_angle += self.state[0, SPEED] * self.limits.dt / wheel_radius
+        """Integrate the wheels' rotation (rad) over the step (:attr:`wheel_angle`)."""
+        raise NotImplementedError
 
     @property
     def dt(self) -> float:
@@ -136,21 +134,12 @@ class SimWorld:
         """``(x m, y m, heading rad)`` in the maze frame (heading not wrapped)."""
         return float(self.state[0, X]), float(self.state[0, Y]), float(self.state[0, HEADING])
 
-    @property
-    def steering(self) -> np.ndarray:
-        """(4,) current wheel angles (rad)."""
-        return self.state[0, ANGLE_FL : ANGLE_FL + 4].copy()
-
-    @property
-    def speed(self) -> float:
-        """Current wheel speed (m/s)."""
-        return float(self.state[0, SPEED])
-
     def step(self, command: np.ndarray, wheel_radius: float = 0.02) -> float:
         """Apply a command for one control period.
 
-        The command is ``(speed, fl, fr, rl, rr)`` for a 4WS robot; ``wheel_radius`` (m)
-        turns its speed into wheel rotation.
+        The command is the motion model's (4WS: ``(speed m/s, fl, fr, rl, rr rad)``;
+        differential drive: ``(v m/s, omega rad/s)``); ``wheel_radius`` (m) turns the
+        motion into wheel rotation.
 
         Returns:
             Distance travelled (m); 0 if the wheels fought or a wall was in the way.

@@ -1,6 +1,7 @@
 """The bridge's world for a differential-drive robot.
 
-The 4WS world's maze, walls, laser and episode, with the differential-drive motion model
+The kinematic world's maze, walls, laser and episode
+(:class:`~sim_bridge.world.KinematicWorld`), with the differential-drive motion model
 (:mod:`sim_bridge.diff_drive.motion`).
 """
 
@@ -10,16 +11,16 @@ import numpy as np
 
 from evorbc_ros.robots.registry import lookup
 from sim_bridge.diff_drive.motion import OMEGA, STATE_SIZE, V, body_twist, diff_limits, step_diff
-from sim_bridge.world import SimWorld
+from sim_bridge.world import KinematicWorld
 
 _NO_BOXES = np.empty((0, 6))
 _NO_CANDIDATES = np.empty(0, dtype=np.int64)
 
 
-class DiffDriveWorld(SimWorld):
+class DiffDriveWorld(KinematicWorld):
     """A differential-drive robot in a maze, stepped by body twists ``(v m/s, omega rad/s)``.
 
-    Constructed as :class:`~sim_bridge.world.SimWorld`; ``robot`` names a registered
+    Constructed as :class:`~sim_bridge.world.KinematicWorld`; ``robot`` names a registered
     differential-drive robot (its ``model`` is its geometry) and ``geometry`` may replace it.
     """
 

@@ -44,7 +44,7 @@ class SimAdapters:
 #: The families evorbc simulates.
 BUILTIN = {
     "four_ws": SimAdapters(
-        "sim_bridge.four_ws.robot:simulated_robot", "sim_bridge.bridge_robots:FourWSBridge"
+        "sim_bridge.four_ws.robot:simulated_robot", "sim_bridge.four_ws.bridge:FourWSBridge"
     ),
     "diff_drive": SimAdapters(
         "sim_bridge.diff_drive.robot:simulated_robot",
@@ -52,7 +52,7 @@ BUILTIN = {
     ),
     "hexapod": SimAdapters(
         "sim_bridge.hexapod.robot:simulated_robot",
-        "sim_bridge.bridge_robots:HexapodBridge",
+        "sim_bridge.hexapod.bridge:HexapodBridge",
         "sim_bridge.hexapod.design:check_controller",
     ),
     "legged": SimAdapters(
