@@ -28,10 +28,10 @@ from evorbc_ros.network import ConnectionSpec, NetworkSpec, NodeSpec
 from offline_evolution.arbitrator.settings import load_run_settings
 from offline_evolution.maze_task.hexapod_task import HexapodMazeTask
 from offline_evolution.maze_task.task import MazeTaskSettings
-from sim_bridge.hexapod.evaluate import X, Y, evaluate_genes
 from sim_bridge.hexapod.physics import HexapodSim
 from sim_bridge.hexapod.robot import DISCARD_TILT
 from sim_bridge.legged.episode import EpisodeRunner, LeggedController
+from sim_bridge.legged.evaluate import X, Y, evaluate_genes
 
 N_INPUTS = 6  # five laser groups and the goal bearing (config/sensors/hexapod.yaml)
 HIDDEN = (100, 101)  # keys of the two hidden nodes

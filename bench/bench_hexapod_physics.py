@@ -21,8 +21,8 @@ import time
 import numpy as np
 
 from evorbc_ros.repertoire import Repertoire
-from sim_bridge.hexapod.evaluate import HEADING, TILT, X, Y, evaluate_genes
 from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings
+from sim_bridge.legged.evaluate import HEADING, TILT, X, Y, evaluate_genes
 
 T = 2.0
 PERIOD = 0.1

@@ -28,8 +28,8 @@ from evorbc_ros.repertoire import Repertoire
 from offline_evolution.repertoire.map_elites import generate_repertoire
 from offline_evolution.repertoire.settings import load_settings
 from offline_evolution.repertoire.stats import repertoire_stats
-from sim_bridge.hexapod.pool import available_cores
 from sim_bridge.hexapod.robot import HexapodRobot
+from sim_bridge.legged.pool import available_cores
 
 PAPER_COUNT = 336  # primitives in the paper's hexapod repertoire (Sec. V-B)
 COMBOS = [("paper", "grid"), ("iso_line_dd", "grid"), ("paper", "cvt"), ("iso_line_dd", "cvt")]

@@ -20,10 +20,10 @@ import argparse
 import numpy as np
 
 from evorbc_ros.robots.hexapod import GaitTable, HexapodGeometry
-from sim_bridge.hexapod.evaluate import TILT, X, Y, evaluate_genes
 from sim_bridge.hexapod.maze_world import FALLEN_TILT
 from sim_bridge.hexapod.physics import HexapodSim
 from sim_bridge.hexapod.robot import DISCARD_TILT
+from sim_bridge.legged.evaluate import TILT, X, Y, evaluate_genes
 
 #: The first design (fast servos, long shins); the other variants change it.
 FIRST = {"max_joint_velocity": 10.0, "tibia_length": 0.14}

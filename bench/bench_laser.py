@@ -40,7 +40,7 @@ from evorbc_ros.config import config_dir
 from evorbc_ros.laser import InputError, LaserPose, LaserToRangefinders
 from evorbc_ros.sensors import SensorLayout
 from sim_bridge.geometry import cast_ray_dir
-from sim_bridge.hexapod.scanner import Scanner
+from sim_bridge.legged.scanner import Scanner
 from sim_bridge.maze import load_named_maze
 
 RANGE_MAX = 2.0  # m, as the bridge's laser

@@ -4,9 +4,9 @@ import numpy as np
 
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.hexapod import mirror_genes, parameter_specs
-from sim_bridge.hexapod.evaluate import HEADING, TILT, X, Y, evaluate_genes
 from sim_bridge.hexapod.physics import HexapodSim
 from sim_bridge.hexapod.robot import DISCARD_TILT, describe_simulation
+from sim_bridge.legged.evaluate import HEADING, TILT, X, Y, evaluate_genes
 
 
 def tripod(offset_a=0.0):

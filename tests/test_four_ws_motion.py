@@ -18,7 +18,7 @@ from sim_bridge.four_ws.motion import (
     step_robot,
 )
 from sim_bridge.geometry import wall_boxes
-from sim_bridge.kinematics import run_primitives
+from sim_bridge.kinematics import run_model_primitives
 
 G = FourWSGeometry()
 LIM = motion_limits(G)
@@ -45,14 +45,14 @@ def steps(state, command, n, walls=NO_WALLS):
 
 def test_straight_from_rest_accelerates_then_cruises():
     # Speed ramps 0.04, 0.08, ..., 0.20 m/s (0.4 m/s^2), then holds: 0.06 m + 15 * 0.02 m.
-    out = run_primitives(np.array([[0.2, 0, 0, 0, 0], [-0.2, 0, 0, 0, 0]], float), 20, LIM)
+    out = run_model_primitives(np.array([[0.2, 0, 0, 0, 0], [-0.2, 0, 0, 0, 0]], float), 20, LIM)
     np.testing.assert_allclose(out[0], [0.36, 0.0, 0.0, 0.36], atol=1e-12)
     np.testing.assert_allclose(out[1], [-0.36, 0.0, 0.0, 0.36], atol=1e-12)
 
 
 def test_crab_motion_from_rest_follows_the_ramping_wheels():
     a = 30 * DEG
-    out = run_primitives(np.array([[0.2, a, a, a, a]]), 20, LIM)[0]
+    out = run_model_primitives(np.array([[0.2, a, a, a, a]]), 20, LIM)[0]
     # Angles ramp 9, 18, 27, 30 deg while the speed ramps; all wheels stay parallel.
     legs = [(0.004, 9), (0.008, 18), (0.012, 27), (0.016 + 15 * 0.02 + 0.02, 30)]
     x = sum(s * math.cos(d * DEG) for s, d in legs)
@@ -171,9 +171,9 @@ def test_primitives_do_not_depend_on_the_number_of_threads():
     before = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
-        one = run_primitives(cmds, 20, LIM)
+        one = run_model_primitives(cmds, 20, LIM)
         numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
-        many = run_primitives(cmds, 20, LIM)
+        many = run_model_primitives(cmds, 20, LIM)
     finally:
         numba.set_num_threads(before)
     np.testing.assert_array_equal(one, many)

@@ -17,7 +17,7 @@ from reference_four_ws import Margins, State, reference_primitive, reference_ste
 from evorbc_ros.robots.four_ws import FourWSGeometry
 from sim_bridge.four_ws.motion import STATE_SIZE, motion_limits, step_robot
 from sim_bridge.geometry import wall_boxes
-from sim_bridge.kinematics import run_primitives
+from sim_bridge.kinematics import run_model_primitives
 
 TOL = 1e-9  # m and rad
 MARGIN = 1e-9  # keep inputs this far from every threshold
@@ -152,7 +152,7 @@ def _safe(cmds: np.ndarray, steps: int) -> tuple[np.ndarray, list[tuple]]:
     return np.array(kept).reshape(-1, 5), results
 
 
-# --- (a) constant commands through run_primitives ----------------------------------------
+# --- (a) constant commands through run_model_primitives ----------------------------------------
 
 
 @pytest.mark.parametrize("family", list(FAMILIES))
@@ -163,7 +163,7 @@ def test_primitives_match_reference(family):
     cmds = np.vstack([cmds, _mirrored(cmds)])
     safe, expected = _safe(cmds, STEPS)
     assert len(safe) >= 0.95 * len(cmds), "too many inputs near a threshold"
-    got = run_primitives(np.ascontiguousarray(safe), STEPS, LIM)
+    got = run_model_primitives(np.ascontiguousarray(safe), STEPS, LIM)
     assert got.shape == (len(safe), 4)
     expected = np.array(expected)
     err = np.abs(got - expected)
@@ -188,8 +188,8 @@ def test_primitives_mirror_symmetry():
     cmds, _ = _safe(_uniform(rng, 500), STEPS)
     mirrored, _ = _safe(_mirrored(cmds), STEPS)
     assert len(mirrored) == len(cmds)
-    a = run_primitives(np.ascontiguousarray(cmds), STEPS, LIM)
-    b = run_primitives(np.ascontiguousarray(mirrored), STEPS, LIM)
+    a = run_model_primitives(np.ascontiguousarray(cmds), STEPS, LIM)
+    b = run_model_primitives(np.ascontiguousarray(mirrored), STEPS, LIM)
     np.testing.assert_allclose(b[:, [0, 3]], a[:, [0, 3]], rtol=0, atol=TOL)
     np.testing.assert_allclose(b[:, [1, 2]], -a[:, [1, 2]], rtol=0, atol=TOL)
 
@@ -297,5 +297,5 @@ def test_rounding_level_side_difference_counts_as_parallel():
     safe, expected = _safe(exact, STEPS)
     nudged = safe.copy()
     nudged[:, 3] += 1e-12
-    got = run_primitives(np.ascontiguousarray(nudged), STEPS, LIM)
+    got = run_model_primitives(np.ascontiguousarray(nudged), STEPS, LIM)
     np.testing.assert_allclose(got, np.array(expected), rtol=0, atol=TOL)

@@ -1,5 +1,6 @@
 """The hexapod: URDF, servos, primitives (eq. 10-11), resets, determinism and tilt."""
 
+import functools
 import math
 
 import numpy as np
@@ -16,11 +17,11 @@ from evorbc_ros.robots.hexapod import (
 )
 from offline_evolution.quality import circular_tilt_quality
 from sim_bridge.geometry import wall_boxes
-from sim_bridge.hexapod.evaluate import HEADING, SECONDS, TILT, X, Y, evaluate_genes
 from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings
-from sim_bridge.hexapod.pool import EvaluationPool
 from sim_bridge.hexapod.robot import DISCARD_TILT, HexapodRobot
-from sim_bridge.hexapod.scanner import Scanner
+from sim_bridge.legged.evaluate import HEADING, SECONDS, TILT, X, Y, evaluate_genes
+from sim_bridge.legged.pool import EvaluationPool
+from sim_bridge.legged.scanner import Scanner
 
 G = HexapodGeometry()
 
@@ -131,9 +132,9 @@ def test_same_primitive_gives_identical_outcomes_whatever_ran_before(sim):
 
 def test_results_do_not_depend_on_the_number_of_workers():
     genes = np.random.default_rng(6).uniform(-1, 1, (45, N_PARAMETERS))
-    with EvaluationPool(G, PhysicsSettings(), 1) as one:
+    with EvaluationPool(functools.partial(HexapodSim, G, PhysicsSettings()), 1) as one:
         serial = one.evaluate(genes, 2.0, 0.1, DISCARD_TILT)
-    with EvaluationPool(G, PhysicsSettings(), 2) as two:
+    with EvaluationPool(functools.partial(HexapodSim, G, PhysicsSettings()), 2) as two:
         parallel = two.evaluate(genes, 2.0, 0.1, DISCARD_TILT)
     np.testing.assert_array_equal(serial, parallel)
 

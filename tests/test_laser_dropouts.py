@@ -11,7 +11,7 @@ from evorbc_ros.config import config_dir
 from evorbc_ros.laser import InputError, LaserToRangefinders, beam_tolerance, check_beam_count
 from evorbc_ros.sensors import SensorLayout
 from sim_bridge.four_ws.world import FourWSWorld
-from sim_bridge.hexapod.scanner import Scanner
+from sim_bridge.legged.scanner import Scanner
 from sim_bridge.maze import load_named_maze
 from sim_bridge.world import LaserConfig
 

@@ -13,7 +13,7 @@ from reference_laser import OldLaserToRangefinders
 from evorbc_ros.config import config_dir
 from evorbc_ros.laser import LaserPose, LaserToRangefinders
 from evorbc_ros.sensors import SensorLayout
-from sim_bridge.hexapod.scanner import Scanner
+from sim_bridge.legged.scanner import Scanner
 
 LAYOUTS = {
     name: SensorLayout.load(config_dir() / "sensors" / f"{name}.yaml").rangefinders

@@ -23,11 +23,11 @@ from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.hexapod import GaitTable, HexapodGeometry, hexapod_gait, mirror_genes
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
-from sim_bridge.hexapod.evaluate import HEADING, PATH, TILT, X, Y, evaluate_genes
 from sim_bridge.hexapod.physics import HexapodSim, PhysicsSettings, hexapod_settings
 from sim_bridge.hexapod.robot import DISCARD_TILT, HexapodRobot, describe_simulation
 from sim_bridge.hexapod.urdf import hexapod_urdf
 from sim_bridge.legged import episode as legged_episode
+from sim_bridge.legged.evaluate import HEADING, PATH, TILT, X, Y, evaluate_genes
 from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.legged.robot import LeggedRobot
 from sim_bridge.legged.settings import load_robot_settings

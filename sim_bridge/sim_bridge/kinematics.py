@@ -105,9 +105,3 @@ def run_model_primitives(commands, n_steps, lim):
         out[i, 2] = state[i, HEADING]
         out[i, 3] = path
     return out
-
-
-#: The 4WS robots' name for :func:`run_model_primitives` (``(n, 5)`` wheel commands and
-#: :class:`~sim_bridge.four_ws.motion.MotionLimits`). It lives here, not beside the 4WS
-#: model, because this module imports the model: one direction only.
-run_primitives = run_model_primitives

@@ -8,7 +8,7 @@ from evorbc_ros.robots.four_ws import FourWSGeometry, FourWSType
 from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.robots.registry import robot_type
 from sim_bridge.four_ws.motion import motion_limits
-from sim_bridge.kinematics import run_primitives
+from sim_bridge.kinematics import run_model_primitives
 from sim_bridge.robots.base import PrimitiveOutcome, control_steps
 
 
@@ -66,7 +66,7 @@ class FourWSRobot:
             )
         steps = control_steps(eval_time, self.geometry.control_period)
         commands = np.ascontiguousarray(self.type.commands(genes, self.geometry))
-        out = run_primitives(commands, steps, self.limits)
+        out = run_model_primitives(commands, steps, self.limits)
         return PrimitiveOutcome(x=out[:, 0], y=out[:, 1], heading=out[:, 2], path=out[:, 3])
 
 

@@ -1,1 +1,5 @@
-"""The hexapod in PyBullet: URDF, physics, primitive evaluation and worker pools."""
+"""The hexapod's simulation: URDF, physics, search robot, maze world, bridge adapter, design check.
+
+The simulation half of :mod:`evorbc_ros.robots.hexapod`, built on the legged robots' code
+(:mod:`sim_bridge.legged`).
+"""

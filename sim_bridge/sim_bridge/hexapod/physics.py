@@ -18,16 +18,7 @@ import numpy as np
 from evorbc_ros.config import config_dir
 from evorbc_ros.robots.hexapod import HEXAPOD, HexapodGeometry, hexapod_gait
 from sim_bridge.hexapod.urdf import hexapod_urdf
-
-# The simulation's pieces are the legged robot's; the names stay importable from here.
-from sim_bridge.legged.physics import (  # noqa: F401
-    GROUND_GROUP,
-    ROBOT_GROUP,
-    WALL_GROUP,
-    LeggedSim,
-    _tilt,
-    _yaw,
-)
+from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.legged.settings import (
     LeggedRobotSettings,
     PhysicsSettings,
