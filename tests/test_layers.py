@@ -119,3 +119,26 @@ def test_the_onboard_package_names_no_higher_layer_not_even_in_a_string():
                 if w != "evorbc_ros" and w in text
             ]
     assert named == []
+
+
+def test_each_robot_family_has_its_one_folder_in_the_simulation():
+    """docs/design.md section 19: each family's simulation code is ``sim_bridge/<family>/``,
+    beside its onboard module ``evorbc_ros/robots/<family>.py``; its adapters point into it,
+    and no module outside it is named after a family."""
+    from sim_bridge.robots.adapters import BUILTIN
+
+    sim = PACKAGES["sim_bridge"]
+    onboard = PACKAGES["evorbc_ros"] / "robots"
+    assert sorted(BUILTIN) == ["diff_drive", "four_ws", "hexapod", "legged"]
+    for family, adapters in BUILTIN.items():
+        assert (onboard / f"{family}.py").is_file(), family
+        assert (sim / family / "__init__.py").is_file(), family
+        paths = [adapters.simulation, adapters.bridge, adapters.design_check]
+        outside = [p for p in paths if p and not p.startswith(f"sim_bridge.{family}.")]
+        assert outside == [], family
+    stray = [
+        str(path.relative_to(sim))
+        for path in sim.rglob("*.py")
+        if path.parent.name not in BUILTIN and path.stem.startswith(tuple(BUILTIN))
+    ]
+    assert stray == []
