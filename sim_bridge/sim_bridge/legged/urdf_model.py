@@ -53,11 +53,26 @@ class UrdfJoint:
 
 @dataclass(frozen=True)
 class UrdfLink:
-    """One ``<link>``: its mass (kg) and diagonal inertia (kg m^2; zeros when absent)."""
+    """One ``<link>``: its mass (kg) and inertia (kg m^2; zeros when absent)."""
 
     name: str
     mass: float
-    inertia: tuple[float, float, float]
+    inertia: tuple[float, ...]  # ixx, iyy, izz, ixy, ixz, iyz
+
+    def inertia_problem(self) -> str | None:
+        """Why PyBullet would not take the inertia (it zeroes a bad one), or None."""
+        ixx, iyy, izz, ixy, ixz, iyz = self.inertia
+        if self.mass <= 0.0:
+            return None
+        if min(ixx, iyy, izz) <= 0.0:
+            return "zero"
+        tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        a, b, c = np.linalg.eigvalsh(tensor)
+        # A rigid body's principal moments are positive and each at most the sum of the
+        # other two (the triangle inequality).
+        if a <= 0.0 or c > (a + b) * (1.0 + 1e-9):
+            return "not physical"
+        return None
 
 
 @dataclass(frozen=True)
@@ -112,8 +127,8 @@ def read_urdf(path: str | os.PathLike) -> UrdfModel:
         inertial = element.find("inertial")
         mass = _number(inertial.find("mass") if inertial is not None else None, "value", 0.0, where)
         inertia = inertial.find("inertia") if inertial is not None else None
-        diagonal = tuple(_number(inertia, k, 0.0, where) for k in ("ixx", "iyy", "izz"))
-        links[name] = UrdfLink(name, mass, diagonal)
+        keys = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+        links[name] = UrdfLink(name, mass, tuple(_number(inertia, k, 0.0, where) for k in keys))
     joints = {}
     for element in robot.findall("joint"):  # top level only: <transmission> has <joint>s too
         name = element.get("name")
@@ -154,16 +169,16 @@ def check_inertias(model: UrdfModel, links: list[str]) -> None:
         UrdfError: one line naming the file and the first such links.
 
     """
-    bad = [
-        name
-        for name in links
-        if model.links[name].mass > 0 and min(model.links[name].inertia) <= 0.0
-    ]
-    if bad:
+    problems = {name: model.links[name].inertia_problem() for name in links}
+    for kind in ("zero", "not physical"):
+        bad = [name for name, problem in problems.items() if problem == kind]
+        if not bad:
+            continue
         shown = ", ".join(bad[:4]) + (f" and {len(bad) - 4} more" if len(bad) > 4 else "")
+        what = "zero inertias" if kind == "zero" else "inertias no rigid body has"
         raise UrdfError(
-            f"{model.path}: zero inertias ({shown}): set each link's <inertia> ixx, iyy, izz "
-            "(kg m^2) to its real values"
+            f"{model.path}: {what} ({shown}): set each link's <inertia> (kg m^2) to its "
+            "real values (positive principal moments, each at most the sum of the others)"
         )
 
 

@@ -10,6 +10,7 @@ tunes them. Units: m, s, deg in ``*_deg`` keys, N m.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -237,7 +238,7 @@ def declaration_text(name: str, model_file: str, description: str) -> str:
         "# A1's, from evorbc's config/: copy one beside this file to change it.\n"
         "kind: legged\n"
         f"model: {model_file}\n"
-        f"description: {description}\n"
+        f"description: {json.dumps(description)}\n"  # a YAML string
         "settings:\n"
         "  repertoire: repertoire/a1.yaml\n"
         "  arbitrator: arbitrator/a1.yaml\n"
