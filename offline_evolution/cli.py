@@ -9,6 +9,7 @@ Subcommands:
     mazes        generate seeded, proven-solvable mazes for a robot
     evaluate     run a controller on a suite of mazes from many starts, perturbed or not
     recipe       make a shipped controller from its recipe (config/recipes/*.yaml)
+    robot-from-urdf  a legged robot's settings files read from its URDF
 
 Bad arguments or files end the program with a one-line message and a non-zero status,
 never a traceback (set ``EVORBC_DEBUG=1`` to see one for an unexpected failure).
@@ -25,7 +26,15 @@ from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.config import ConfigError
 from evorbc_ros.repertoire import RepertoireError
 from offline_evolution.checkpoint import CheckpointError
-from offline_evolution.commands import arbitrator, evaluate, mazes, recipe, repertoire, replay
+from offline_evolution.commands import (
+    arbitrator,
+    evaluate,
+    mazes,
+    recipe,
+    repertoire,
+    replay,
+    robot_from_urdf,
+)
 from offline_evolution.commands.common import EXIT_ERROR, EXIT_INTERRUPTED, CliError
 from sim_bridge.cli_support import OneLineParser, report_unexpected
 from sim_bridge.cluster_pool import CLUSTER_VARIABLE, ClusterError
@@ -45,6 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
     mazes.add_parsers(sub)
     evaluate.add_parsers(sub)
     recipe.add_parsers(sub)
+    robot_from_urdf.add_parsers(sub)
     return parser
 
 
