@@ -37,6 +37,7 @@ Arbitrators (paper Sec. III-C):
 """
 
 from evorbc_ros.lazy_exports import lazy_exports
+from evorbc_ros.numba_caches import drop_stale_caches
 
 _EXPORTS = {
     "ArbitratorTask": "offline_evolution.task_protocol",
@@ -59,4 +60,6 @@ _EXPORTS = {
     "quality_metric": "offline_evolution.quality",
 }
 __all__ = sorted(_EXPORTS)
+# Caches left by an earlier version whose modules have moved break numba (see numba_caches).
+drop_stale_caches(__path__[0])
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -29,6 +29,7 @@ angles in rad, behaviours in the primitive's start frame, x forward and y left):
 """
 
 from evorbc_ros.lazy_exports import lazy_exports
+from evorbc_ros.numba_caches import drop_stale_caches
 
 _EXPORTS = {
     "Arbitrator": "evorbc_ros.arbitrator",
@@ -47,4 +48,6 @@ _EXPORTS = {
     "choose_primitive": "evorbc_ros.mapping",
 }
 __all__ = sorted(_EXPORTS)
+# Caches left by an earlier version whose modules have moved break numba (see numba_caches).
+drop_stale_caches(__path__[0])
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

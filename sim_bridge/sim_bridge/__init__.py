@@ -16,6 +16,7 @@ The public API (``n`` primitives; lengths in m, angles in rad):
 """
 
 from evorbc_ros.lazy_exports import lazy_exports
+from evorbc_ros.numba_caches import drop_stale_caches
 
 _EXPORTS = {
     "Maze": "sim_bridge.maze",
@@ -24,4 +25,6 @@ _EXPORTS = {
     "load_named_maze": "sim_bridge.maze",
 }
 __all__ = sorted(_EXPORTS)
+# Caches left by an earlier version whose modules have moved break numba (see numba_caches).
+drop_stale_caches(__path__[0])
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
