@@ -6,7 +6,8 @@ upgrade that moves a module (issue 40 moved the 4WS and diff-drive models into t
 family folders), an index left in ``__pycache__`` names a module that no longer exists,
 and the first call of the cached function raises ``ModuleNotFoundError`` instead of
 recompiling. pip removes the ``.pyc`` files of an uninstalled version but not numba's
-``.nbi``/``.nbc`` files, so an in-place upgrade hits this (docs/design.md section 16).
+``.nbi``/``.nbc`` files, so an in-place upgrade hits this (docs/design.md section 16,
+docs/design/performance.md).
 
 Each package records the layout of its modules (the sorted paths of its ``.py`` files)
 beside its caches; when the layout differs, every numba cache file of the package is
