@@ -1,8 +1,9 @@
 """How a process runs a run: Ctrl-C finishes the current step, errors end as one line.
 
-The runs (:mod:`offline_evolution.runs`) never print and never touch signals; the front
-ends (``evorbc-evolve``, a study's worker process, a recipe) run them in this frame
-(docs/design.md section 15).
+The runs (:mod:`offline_evolution.runs`) never print; the front ends (``evorbc-evolve``, a
+study's worker process, a recipe) run them in this frame and pass a :class:`StopOnSignal`
+as their ``should_stop``, which a run lets catch signals only while it searches
+(:func:`listening`; docs/design.md section 15).
 """
 
 from __future__ import annotations
