@@ -33,13 +33,13 @@ from bench_hexapod_repertoire import machine
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.commands.evaluate import HELD_OUT_SEED
 from offline_evolution.maze_task import evaluation
 from offline_evolution.maze_task.base import MazeTaskSettings
 from offline_evolution.maze_task.perturbation import NONE, load_perturbations
 from offline_evolution.maze_task.task import make_task
 from offline_evolution.mazes.files import save_maze
 from offline_evolution.mazes.generator import generate_maze, spec_for_robot
+from offline_evolution.mazes.held_out import HELD_OUT_SEED
 
 PAPER = ("obstacle", "zigzag", "baffles", "corridors", "gaps")
 ROOT = Path(__file__).resolve().parents[1]

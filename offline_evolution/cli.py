@@ -22,10 +22,6 @@ import os
 import sys
 from collections.abc import Sequence
 
-from evorbc_ros.arbitrator import ArbitratorError
-from evorbc_ros.config import ConfigError
-from evorbc_ros.repertoire import RepertoireError
-from offline_evolution.checkpoint import CheckpointError
 from offline_evolution.commands import (
     arbitrator,
     evaluate,
@@ -35,9 +31,9 @@ from offline_evolution.commands import (
     replay,
     robot_from_urdf,
 )
-from offline_evolution.commands.common import EXIT_ERROR, EXIT_INTERRUPTED, CliError
-from sim_bridge.cli_support import OneLineParser, report_unexpected
-from sim_bridge.cluster_pool import CLUSTER_VARIABLE, ClusterError
+from offline_evolution.runs.frame import one_line_errors
+from sim_bridge.cli_support import OneLineParser
+from sim_bridge.cluster_pool import CLUSTER_VARIABLE
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -65,19 +61,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if getattr(args, "cluster", None):
         # The evaluation pools read it when they first spread work (sim_bridge/cluster_pool).
         os.environ[CLUSTER_VARIABLE] = args.cluster
-    try:
-        return args.func(args)
-    except CliError as e:
-        print(f"evorbc-evolve: error: {e}", file=sys.stderr)
-        return e.code
-    except (ConfigError, RepertoireError, CheckpointError, ArbitratorError, ClusterError) as e:
-        print(f"evorbc-evolve: error: {e}", file=sys.stderr)
-        return EXIT_ERROR
-    except KeyboardInterrupt:
-        print("evorbc-evolve: aborted", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except Exception as e:
-        return report_unexpected("evorbc-evolve", e)
+    return one_line_errors("evorbc-evolve", lambda: args.func(args))
 
 
 if __name__ == "__main__":

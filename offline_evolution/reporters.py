@@ -1,9 +1,11 @@
-"""What a NEAT run tells as it goes: reporters, in neat-python's ``BaseReporter`` way.
+"""What a run tells as it goes: reporters, in neat-python's ``BaseReporter`` way.
 
-A run (:func:`~offline_evolution.arbitrator.evolve.evolve`) calls each of its reporters at
-the same points, in order; a reporter overrides what it wants and inherits a no-op for the
-rest. The command line prints through one (``commands/arbitrator.py``), a study or a test
-can count or log through another, and none of them changes what the run computes.
+A run (the runs of :mod:`offline_evolution.runs`, and
+:func:`~offline_evolution.arbitrator.evolve.evolve` under them) calls each of its
+reporters at the same points, in order; a reporter overrides what it wants and inherits a
+no-op for the rest. The command line prints through the console ones
+(:mod:`offline_evolution.runs.console`), a study or a test can count or log through
+another, and none of them changes what the run computes.
 """
 
 from __future__ import annotations
@@ -13,6 +15,12 @@ from collections.abc import Callable, Sequence
 
 class Reporter:
     """A reporter that ignores everything; subclass it and override what you need."""
+
+    def search_start(self, settings) -> None:
+        """A run's checks passed and its search starts with ``settings`` (resolved).
+
+        ``EvolutionSettings`` of an arbitrator run (``generations`` is the total).
+        """
 
     def resumed(self, generations: int) -> None:
         """The run resumes from its checkpoint with ``generations`` already done.
@@ -38,12 +46,33 @@ class Reporter:
         """
         return type(self).post_evaluation is not Reporter.post_evaluation
 
+    def iteration_end(self, progress) -> None:
+        """A MAP-Elites batch finished: ``progress`` (``map_elites.Progress``).
+
+        Its ``resumed_from`` is the iteration a resumed run started from (None if fresh).
+        """
+
+    def episodes_done(self, done: int, total: int) -> None:
+        """``done`` of a replay's or an evaluation's ``total`` episodes finished.
+
+        ``done == 0`` starts the batch. Only tasks that report call it (the legged
+        robots'; ``MazeTaskBase.progress``).
+        """
+
+    def warning(self, message: str) -> None:
+        """Something the user should know that does not stop the run (one line)."""
+
 
 class Reporters(Reporter):
     """Several reporters as one, called in the order given."""
 
     def __init__(self, reporters: Sequence[Reporter] = ()) -> None:
         self.reporters = tuple(reporters)
+
+    def search_start(self, settings) -> None:
+        """Tell every reporter."""
+        for r in self.reporters:
+            r.search_start(settings)
 
     def resumed(self, generations: int) -> None:
         """Tell every reporter."""
@@ -59,6 +88,21 @@ class Reporters(Reporter):
         """Tell every reporter."""
         for r in self.reporters:
             r.post_evaluation(done, total, finalists)
+
+    def iteration_end(self, progress) -> None:
+        """Tell every reporter."""
+        for r in self.reporters:
+            r.iteration_end(progress)
+
+    def episodes_done(self, done: int, total: int) -> None:
+        """Tell every reporter."""
+        for r in self.reporters:
+            r.episodes_done(done, total)
+
+    def warning(self, message: str) -> None:
+        """Tell every reporter."""
+        for r in self.reporters:
+            r.warning(message)
 
     def episodes(self, finalists: bool) -> Callable[[int, int], None] | None:
         """A task's ``(done, total)`` callback for one round; None if no reporter wants it."""

@@ -228,10 +228,10 @@ def test_restart_deletes_only_a_neat_checkpoint(tmp_path, capsys, small_repertoi
 
 def test_progress_says_when_a_run_resumes_from_its_checkpoint(capsys):
     from offline_evolution.arbitrator.evolve import GenerationStats
-    from offline_evolution.commands.arbitrator import _GenerationPrinter
+    from offline_evolution.runs.console import GenerationPrinter
 
     def lines(first_generation, quiet=False):
-        printer = _GenerationPrinter(quiet=quiet, total=655)
+        printer = GenerationPrinter(quiet=quiet, total=655)
         if first_generation:  # what evolve() calls on restoring a checkpoint
             printer.resumed(first_generation)
         for g in (first_generation, first_generation + 1):
@@ -248,9 +248,9 @@ def test_progress_says_when_a_run_resumes_from_its_checkpoint(capsys):
 
 def test_the_eta_is_not_thrown_by_one_slow_generation(capsys):
     from offline_evolution.arbitrator.evolve import GenerationStats
-    from offline_evolution.commands.arbitrator import _GenerationPrinter
+    from offline_evolution.runs.console import GenerationPrinter
 
-    printer = _GenerationPrinter(quiet=False, total=110)
+    printer = GenerationPrinter(quiet=False, total=110)
     for g, seconds in enumerate([30.0, 30.0, 300.0, 30.0]):  # generation 3 paused 270 s
         printer.generation_end(GenerationStats(g, 0.4, 0.1, 0.4, 3, seconds, seconds, 0), None)
     lines = capsys.readouterr().err.splitlines()

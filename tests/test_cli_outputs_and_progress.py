@@ -4,9 +4,8 @@ status, and an ETA that is not wild at the start."""
 import pytest
 
 from offline_evolution.cli import main
-from offline_evolution.commands.arbitrator import _GenerationPrinter
-from offline_evolution.commands.repertoire import _ProgressPrinter
 from offline_evolution.repertoire.map_elites import Progress
+from offline_evolution.runs.console import GenerationPrinter, IterationPrinter
 
 
 def run(capsys, *argv):
@@ -94,7 +93,7 @@ class Stats:
 
 
 def test_the_generation_eta_leaves_out_the_compiling_first_generation(capsys):
-    printer = _GenerationPrinter(False, 40)
+    printer = GenerationPrinter(False, 40)
     # The first generation compiles (12 s); the others take 0.5 s: 20 s in all.
     for g, seconds in enumerate([12.0, 0.5, 0.5, 0.5, 0.6]):
         printer.generation_end(Stats(g, seconds), None)
@@ -105,7 +104,7 @@ def test_the_generation_eta_leaves_out_the_compiling_first_generation(capsys):
 
 
 def test_the_last_generation_says_done(capsys):
-    printer = _GenerationPrinter(False, 2)
+    printer = GenerationPrinter(False, 2)
     printer.generation_end(Stats(0, 3.0), None)
     printer.generation_end(Stats(1, 0.5), None)
     assert capsys.readouterr().err.splitlines()[-1].endswith("done")
@@ -125,10 +124,10 @@ def progress(evaluations, elapsed, total=100_000):
 
 
 def test_the_repertoire_eta_uses_the_batches_after_the_first(capsys):
-    printer = _ProgressPrinter(False, interval=0.0)
+    printer = IterationPrinter(interval=0.0)
     # 1000 evaluations a batch: the first took 10 s (start-up), the others 0.5 s each.
     for k in range(8):
-        printer(progress(1000 * (k + 1), 10.0 + 0.5 * k))
+        printer.iteration_end(progress(1000 * (k + 1), 10.0 + 0.5 * k))
     lines = capsys.readouterr().err.splitlines()
     assert lines[0].endswith("eta   --") and lines[3].endswith("eta   --")
     # 2000 evaluations/s after the first batch: 92,000 left take 0.8 min (not 7.7).

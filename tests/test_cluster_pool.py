@@ -159,4 +159,4 @@ def test_a_study_spread_needs_a_cluster_and_runs_take_only_their_cpus(tmp_path):
     assert result.returncode != 0
     assert result.stderr.strip().endswith("--spread needs a Ray cluster (--address or RAY_ADDRESS)")
     run = load_study(study).runs()[0]
-    assert all(cmd[-2:] == ["--workers", "3"] for cmd in commands(run, tmp_path, 3))
+    assert all(cmd[-2:] == ["--workers", "3"] for cmd in commands(run, 3))

@@ -13,8 +13,8 @@ import pytest
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.defaults import default_repertoire, paper_arbitrator
 from evorbc_ros.repertoire import Repertoire
-from offline_evolution.commands.common import EpisodeProgress
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+from offline_evolution.runs.console import EpisodeProgress
 
 
 class Clock:

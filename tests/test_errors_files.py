@@ -15,8 +15,9 @@ from evorbc_ros.defaults import default_arbitrator, default_repertoire
 from evorbc_ros.repertoire import METRICS, Repertoire, RepertoireError
 from offline_evolution import cli
 from offline_evolution.commands import replay
-from offline_evolution.commands.common import CliError
 from offline_evolution.quality import METRICS as OFFLINE_METRICS
+from offline_evolution.runs import replay as replay_runs
+from offline_evolution.runs.errors import UserError
 from sim_bridge import bringup
 
 ARB = json.loads(default_arbitrator().read_text())
@@ -259,13 +260,13 @@ def test_replay_design_check_names_the_file_and_first_setting_that_differs(tmp_p
     arb = ArbitratorFile.load(default_arbitrator())
     rep = Repertoire.load(default_repertoire())
     now = {"geometry": {"tibia_length": 0.10}}
-    replay.check_design(None, arb, "a.json", rep, "r.json")  # nothing recorded: passes
+    replay_runs.check_design(None, arb, "a.json", rep, "r.json")  # nothing recorded: passes
     rep.algorithm = {"simulation": {"geometry": {"tibia_length": 0.14}}}
     with pytest.raises(RepertoireError, match=r"^r.json: .*tibia_length is 0.14 in the rep"):
-        replay.check_design(now, arb, "a.json", rep, "r.json")
+        replay_runs.check_design(now, arb, "a.json", rep, "r.json")
     arb.evolution = {"simulation": {"geometry": {"tibia_length": 0.12}}}
-    with pytest.raises(CliError, match=r"^a.json: .*tibia_length is 0.12 in the arbitrator"):
-        replay.check_design(now, arb, "a.json", None, None)
+    with pytest.raises(UserError, match=r"^a.json: .*tibia_length is 0.12 in the arbitrator"):
+        replay_runs.check_design(now, arb, "a.json", None, None)
 
 
 def test_evorbc_evolve_reports_an_unexpected_failure_in_one_line(capsys, monkeypatch):

@@ -401,7 +401,7 @@ def test_a_study_run_that_dies_of_a_signal_fails_and_is_not_an_interruption(
 
     # Each command of the run kills itself, as numba's thread pool did with 10^6 threads.
     crash = f"import os; os.kill(os.getpid(), {int(sig)})"
-    monkeypatch.setattr(study_run, "CLI", (sys.executable, "-c", crash))
+    monkeypatch.setattr(study_run, "WORKER", (sys.executable, "-c", crash))
     study = write_tiny_study(tmp_path)
     results = tmp_path / "res"
     code, err = study_cli(capfd, "run", study, "--results", results, "--seeds", 1, "--jobs", 1)

@@ -79,7 +79,23 @@ def test_caches_stay_while_the_layout_is_unchanged(tmp_path):
     assert drop_stale_caches(pkg) == 1 and not cache.exists()
 
 
-def test_a_package_without_caches_beside_it_is_left_alone(tmp_path):
+def test_the_layout_is_recorded_before_any_cache_exists(tmp_path):
+    """Caches compiled after the first import are kept: the layout was recorded then."""
     (tmp_path / "__init__.py").write_text("")
     assert drop_stale_caches(tmp_path) == 0
-    assert not (tmp_path / "__pycache__").exists()
+    cache = tmp_path / "__pycache__" / "m.f-3.py311.nbi"
+    cache.write_bytes(b"index")
+    assert drop_stale_caches(tmp_path) == 0 and cache.exists()
+
+
+def test_a_move_in_a_lower_layer_drops_the_caches_that_may_name_its_types(tmp_path):
+    pkg, lower = tmp_path / "pkg", tmp_path / "lower"
+    for folder in (pkg / "__pycache__", lower):
+        folder.mkdir(parents=True)
+    cache = pkg / "__pycache__" / "kernel.run-9.py311.nbi"
+    cache.write_bytes(b"index")
+    drop_stale_caches(pkg, lower)
+    cache.write_bytes(b"index")
+    assert drop_stale_caches(pkg, lower) == 0 and cache.exists()
+    (lower / "motion.py").write_text("")
+    assert drop_stale_caches(pkg, lower) == 1 and not cache.exists()

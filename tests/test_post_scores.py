@@ -17,8 +17,9 @@ from evorbc_ros.repertoire import Repertoire
 from offline_evolution.arbitrator.evolve import evolve
 from offline_evolution.arbitrator.post_scores import PostScores, score_candidates, scores_key
 from offline_evolution.checkpoint import CheckpointError, Interrupted
-from offline_evolution.commands.common import CliError, running
 from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+from offline_evolution.runs.errors import UserError
+from offline_evolution.runs.frame import explained
 
 GENERATIONS = 3
 
@@ -106,7 +107,7 @@ def test_a_damaged_post_scores_entry_is_named(tmp_path, small_neat_file, small_r
 
 
 def test_the_cli_says_the_run_stopped_in_its_post_evaluation():
-    with pytest.raises(CliError) as info, running("generation", "generation"):
+    with pytest.raises(UserError) as info, explained("generation"):
         raise Interrupted(200, "c.json", "the post-evaluation (5 of 66 candidates done)")
     assert str(info.value) == (
         "interrupted during the post-evaluation (5 of 66 candidates done); finished work is "

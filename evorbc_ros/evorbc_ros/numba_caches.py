@@ -9,10 +9,11 @@ recompiling. pip removes the ``.pyc`` files of an uninstalled version but not nu
 ``.nbi``/``.nbc`` files, so an in-place upgrade hits this (docs/design.md section 16,
 docs/design/performance.md).
 
-Each package records the layout of its modules (the sorted paths of its ``.py`` files)
-beside its caches; when the layout differs, every numba cache file of the package is
-deleted once and numba recompiles. Edits to a module's source need nothing: numba's own
-time stamp check handles those.
+Each package records the layout of its modules and of the lower layers' (the sorted paths
+of their ``.py`` files: a compiled signature may name a type of a lower layer, as the
+episode kernel names the 4WS motion limits) beside its caches; when the layout differs,
+every numba cache file of the package is deleted once and numba recompiles. Edits to a
+module's source need nothing: numba's own time stamp check handles those.
 """
 
 from __future__ import annotations
@@ -30,17 +31,23 @@ MARKER = "evorbc-numba-layout"
 CACHE_SUFFIXES = (".nbi", ".nbc")
 
 
-def layout(package: Path) -> str:
-    """A fingerprint of the package's module layout: the sorted ``.py`` paths under it."""
-    names = sorted(p.relative_to(package).as_posix() for p in package.rglob("*.py"))
+def layout(*packages: Path) -> str:
+    """A fingerprint of the packages' module layout: the sorted ``.py`` paths under each."""
+    names = [
+        f"{package.name}/{p.relative_to(package).as_posix()}"
+        for package in packages
+        for p in sorted(package.rglob("*.py"))
+    ]
     return hashlib.sha256("\n".join(names).encode()).hexdigest()
 
 
-def drop_stale_caches(package: str | os.PathLike) -> int:
-    """Delete ``package``'s numba cache files if its module layout changed since they were made.
+def drop_stale_caches(package: str | os.PathLike, *lower: str | os.PathLike) -> int:
+    """Delete ``package``'s numba cache files if the module layout changed since they were made.
 
     Args:
         package: the package folder (holding ``__init__.py``).
+        lower: the folders of the packages it builds on, whose types its compiled
+            signatures may name.
 
     Returns:
         The number of cache files deleted (0 when the layout is unchanged, the caches are
@@ -48,9 +55,11 @@ def drop_stale_caches(package: str | os.PathLike) -> int:
     """
     package = Path(package)
     pycache = package / "__pycache__"
-    if not pycache.is_dir() or not os.access(pycache, os.W_OK):
+    # numba writes its caches beside the sources when it can (else in its own cache
+    # folder, which this does not manage): so does the marker.
+    if not os.access(pycache if pycache.is_dir() else package, os.W_OK):
         return 0
-    now = layout(package)
+    now = layout(package, *map(Path, lower))
     marker = pycache / MARKER
     try:
         if marker.read_text(encoding="utf-8").strip() == now:
@@ -67,6 +76,7 @@ def drop_stale_caches(package: str | os.PathLike) -> int:
                 except OSError:  # another process dropped it first
                     pass
     with contextlib.suppress(OSError):  # a read-only marker: drop again next time
+        pycache.mkdir(exist_ok=True)
         atomic_write_text(marker, now + "\n")
     return dropped
 

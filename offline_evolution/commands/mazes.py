@@ -9,7 +9,7 @@ from pathlib import Path
 
 from evorbc_ros.robots.registry import DEFAULT_ROBOT
 from offline_evolution import bounds
-from offline_evolution.commands.common import CliError
+from offline_evolution.runs.errors import UserError
 from sim_bridge.cli_options import add_robot, add_seed
 from sim_bridge.cli_support import check_output_file, integer_in
 
@@ -70,14 +70,14 @@ def share(text: str) -> float:
 def out_folder(path: str, option: str) -> Path:
     """``path`` as a writable folder (created if missing), or a one-line error."""
     if not path:
-        raise CliError(f"{option} '': an empty name, expected a folder")
+        raise UserError(f"{option} '': an empty name, expected a folder")
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
-        raise CliError(f"{option} {path}: is a file, expected a folder")
+        raise UserError(f"{option} {path}: is a file, expected a folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as e:
-        raise CliError(f"{option} {path}: cannot create the folder ({e.strerror})") from None
+        raise UserError(f"{option} {path}: cannot create the folder ({e.strerror})") from None
     return folder
 
 
@@ -98,7 +98,7 @@ def cmd_mazes(args: argparse.Namespace) -> int:
     prefix = "gen"
     if args.serpentine:  # a robot that cannot hold serpentines: generate_maze refuses it
         if args.seed == HELD_OUT_SEED:
-            raise CliError(
+            raise UserError(
                 f"--seed {HELD_OUT_SEED} is the held-out set's, which has no serpentines; "
                 "choose another seed for --serpentine"
             )

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from offline_evolution.commands.common import CliError, add_workers_option
+from offline_evolution.commands.common import add_workers_option
+from offline_evolution.runs.errors import UserError
 
 
 def add_parsers(sub) -> None:
@@ -47,7 +48,7 @@ def cmd_recipe(args: argparse.Namespace) -> int:
     name = Path(args.recipe).name.removesuffix(".yaml").removesuffix(".yml")
     out = Path(args.out) if args.out else Path("recipe-runs") / f"{name}-{args.budget}"
     if out.exists() and not out.is_dir():
-        raise CliError(f"--out {out} is not a folder")
+        raise UserError(f"--out {out} is not a folder")
     outcomes = run_recipe(recipe, out, args.budget, args.workers, args.quiet)
     unknown = [o.step for o in outcomes if o.verdict is not None and not o.verdict.known]
     if unknown:

@@ -7,7 +7,8 @@ import math
 import re
 from pathlib import Path
 
-from offline_evolution.commands.common import CliError, positive_float
+from offline_evolution.commands.common import positive_float
+from offline_evolution.runs.errors import UserError
 
 #: A robot's name: letters, digits and . _ + -, starting with a letter.
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9._+-]*")
@@ -59,7 +60,7 @@ def _urdf_path(text: str) -> Path:
     try:
         return resolve_urdf(text, Path.cwd() / "command-line")
     except ConfigError:
-        raise CliError(f"URDF {text}: no such file") from None
+        raise UserError(f"URDF {text}: no such file") from None
 
 
 def cmd_robot_from_urdf(args: argparse.Namespace) -> int:
@@ -73,13 +74,13 @@ def cmd_robot_from_urdf(args: argparse.Namespace) -> int:
 
     stance = STANCE if args.stance is None else args.stance
     if not 0.2 <= stance < 1.0:
-        raise CliError(f"--stance {stance:g}: expected a share in [0.2, 1)")
+        raise UserError(f"--stance {stance:g}: expected a share in [0.2, 1)")
     path = _urdf_path(args.urdf)
     turn = None if args.turn is None else tuple(math.radians(a) for a in args.turn)
     derived = read_legged_urdf(path, up=args.up, turn_rpy=turn, stance=stance)
     name = args.name or re.sub(r"[^A-Za-z0-9._+-]", "-", derived.model.name)
     if not _NAME.fullmatch(name):
-        raise CliError(f"--name {name!r}: expected letters, digits and . _ + - (a letter first)")
+        raise UserError(f"--name {name!r}: expected letters, digits and . _ + - (a letter first)")
     folder = out_folder(args.out, "--out")
     model_file = folder / f"{name}-model.yaml"
     turned = None

@@ -44,18 +44,6 @@ SMALL_SELECTION = {
 SMALL_TRAINING = {"generated": 1, "post_mazes": 1}
 
 
-def repertoire_options() -> list[str]:
-    """The ``evorbc-evolve repertoire`` options of the small budget."""
-    return [
-        "--initial-batch",
-        str(SMALL_REPERTOIRE["initial_batch"]),
-        "--batch-size",
-        str(SMALL_REPERTOIRE["batch_size"]),
-        "--iterations",
-        str(SMALL_REPERTOIRE["iterations"]),
-    ]
-
-
 def small_arbitrator_files(
     settings: str, neat: str | None, task: str | None, folder: Path
 ) -> dict[str, Path]:
@@ -66,7 +54,8 @@ def small_arbitrator_files(
         folder: where the copies go (created).
 
     Returns:
-        ``{"--config": run settings, "--neat-config": NEAT file, "--task": task file}``.
+        ``{"config": run settings, "neat_config": NEAT file, "task": task file}`` (the
+        ``ArbitratorRun`` fields).
     """
     folder.mkdir(parents=True, exist_ok=True)
     run = load_run_settings(settings)
@@ -77,15 +66,15 @@ def small_arbitrator_files(
         if data.get(key):
             data[key] = min(data[key], small)
     files = {
-        "--config": folder / "run.yaml",
-        "--neat-config": folder / "neat.ini",
-        "--task": folder / "task.yaml",
+        "config": folder / "run.yaml",
+        "neat_config": folder / "neat.ini",
+        "task": folder / "task.yaml",
     }
     # The copies name each other by absolute path: the run settings' are from config/.
-    data["neat"], data["task"] = str(files["--neat-config"]), str(files["--task"])
-    atomic_write_text(files["--config"], yaml.safe_dump(data, sort_keys=False))
-    atomic_write_text(files["--neat-config"], _small_neat(neat_path))
-    atomic_write_text(files["--task"], _small_task(task_path))
+    data["neat"], data["task"] = str(files["neat_config"]), str(files["task"])
+    atomic_write_text(files["config"], yaml.safe_dump(data, sort_keys=False))
+    atomic_write_text(files["neat_config"], _small_neat(neat_path))
+    atomic_write_text(files["task"], _small_task(task_path))
     return files
 
 

@@ -1,10 +1,11 @@
 """Running a recipe: each step in order, in this process, resumable, then the verdicts.
 
-A step runs the code of the ``evorbc-evolve`` subcommand it stands for (``repertoire``,
-``arbitrator``), called in this process with the options the recipe gives, so it makes
-what that command makes: the same checks before any work, the same checkpoints, locks and
-atomic writes, the same progress lines. Its output and checkpoint are the command's
-defaults in the output folder (``OUT/<out>`` and ``OUT/<out>.checkpoint.*``), so:
+A step runs the run of the ``evorbc-evolve`` subcommand it stands for (``repertoire``,
+``arbitrator``: :mod:`offline_evolution.runs`), called in this process with the settings
+the recipe gives, so it makes what that command makes: the same checks before any work,
+the same checkpoints, locks and atomic writes, the same progress lines. Its output and
+checkpoint are the command's defaults in the output folder (``OUT/<out>`` and
+``OUT/<out>.checkpoint.*``), so:
 
 * a step whose output exists and whose checkpoint does not is finished and is skipped (a
   command writes its output atomically, then deletes its checkpoint);
@@ -17,12 +18,11 @@ run's.
 
 from __future__ import annotations
 
-import argparse
 import json
 import shutil
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from evorbc_ros.atomic_io import atomic_path, atomic_write_text
@@ -30,11 +30,16 @@ from evorbc_ros.config import ConfigError
 from offline_evolution.recipes import budget as budgets
 from offline_evolution.recipes.digest import Verdict
 from offline_evolution.recipes.spec import ArbitratorStep, CopyStep, Recipe, RepertoireStep
+from offline_evolution.runs import arbitrator as arbitrator_runs
+from offline_evolution.runs import repertoire as repertoire_runs
 
 #: The file in an output folder that says which recipe and budget it holds.
 STATE_FILE = "recipe-run.json"
-#: Checkpoint suffix of each kind of step (the subcommands' defaults).
-CHECKPOINT_SUFFIX = {"repertoire": ".checkpoint.npz", "arbitrator": ".checkpoint.json"}
+#: Checkpoint suffix of each kind of step (the runs' defaults).
+CHECKPOINT_SUFFIX = {
+    "repertoire": repertoire_runs.CHECKPOINT_SUFFIX,
+    "arbitrator": arbitrator_runs.CHECKPOINT_SUFFIX,
+}
 
 
 @dataclass(frozen=True)
@@ -65,7 +70,7 @@ def run_recipe(
         say: where the recipe's own lines go (default: stderr).
 
     Raises:
-        CliError: a step failed or was interrupted (its message says how to resume).
+        UserError: a step failed or was interrupted (its message says how to resume).
         ConfigError: ``out`` holds another recipe's or budget's run.
     """
     say = say or (lambda line: print(line, file=sys.stderr))
@@ -135,71 +140,55 @@ def _finished(step, target: Path) -> bool:
 
 
 def _run_step(recipe: Recipe, step, out: Path, budget: str, workers, quiet: bool) -> None:
+    from offline_evolution.runs import terminal
+
     target = out / step.out
     if isinstance(step, CopyStep):
         source = out / recipe.step(step.source).out
         with atomic_path(target) as tmp:
             shutil.copyfile(source, tmp)
-        return
-    if isinstance(step, RepertoireStep):
-        argv = _repertoire_argv(step, budget)
+    elif isinstance(step, RepertoireStep):
+        terminal.repertoire(_repertoire_run(step, budget, target), workers, quiet)
     elif isinstance(step, ArbitratorStep):
-        argv = _arbitrator_argv(recipe, step, out, budget)
+        terminal.arbitrator(_arbitrator_run(recipe, step, out, budget, target), workers, quiet)
     else:  # pragma: no cover - the loader knows no other kind
         raise ConfigError(f"{recipe.path}: step {step.step}: unknown kind {step.run!r}")
-    argv += ["--out", str(target)]
-    if workers:
-        argv += ["--workers", str(workers)]
-    if quiet:
-        argv.append("--quiet")
-    _command(argv)
 
 
-def _repertoire_argv(step: RepertoireStep, budget: str) -> list[str]:
-    argv = ["repertoire", "--robot", step.robot, "--config", step.settings]
-    argv += ["--seed", str(step.seed)]
-    if step.iterations is not None:
-        argv += ["--iterations", str(step.iterations)]
-    if budget == "small":
-        argv += budgets.repertoire_options()  # the last --iterations given wins
-    return argv
+def _repertoire_run(step: RepertoireStep, budget: str, target: Path):
+    """The ``RepertoireRun`` of ``step`` at ``budget``, written to ``target``."""
+    from offline_evolution.runs.repertoire import RepertoireRun
+
+    run = RepertoireRun(
+        robot=step.robot,
+        config=step.settings,
+        seed=step.seed,
+        iterations=step.iterations,
+        out=str(target),
+    )
+    return replace(run, **budgets.SMALL_REPERTOIRE) if budget == "small" else run
 
 
-def _arbitrator_argv(recipe: Recipe, step: ArbitratorStep, out: Path, budget: str) -> list[str]:
-    repertoire = step.repertoire_file or str(out / recipe.step(step.repertoire).out)
-    argv = ["arbitrator", "--repertoire", repertoire, "--seed", str(step.seed)]
-    files = {"--config": step.settings, "--neat-config": step.neat, "--task": step.task}
+def _arbitrator_run(recipe: Recipe, step: ArbitratorStep, out: Path, budget: str, target: Path):
+    """The ``ArbitratorRun`` of ``step`` at ``budget``, written to ``target``."""
+    from evorbc_ros.controller_kinds import EVORBC
+    from offline_evolution.runs.arbitrator import ArbitratorRun
+
+    files = {"config": step.settings, "neat_config": step.neat, "task": step.task}
+    generations = step.generations
     if budget == "small":
         folder = out / "small-settings" / step.step
         files = budgets.small_arbitrator_files(step.settings, step.neat, step.task, folder)
-        argv += ["--generations", str(budgets.SMALL_GENERATIONS)]
-    elif step.generations is not None:
-        argv += ["--generations", str(step.generations)]
-    for option, path in files.items():
-        if path is not None:
-            argv += [option, str(path)]
+        generations = budgets.SMALL_GENERATIONS
     init = step.init_from_file or (
         str(out / recipe.step(step.init_from).out) if step.init_from else None
     )
-    if init is not None:
-        argv += ["--init-from", init]
-    return argv
-
-
-def _command(argv: list[str]) -> None:
-    """Run the ``evorbc-evolve`` subcommand ``argv`` in this process.
-
-    The subcommand's own parser builds its options (defaults included) and its function
-    runs them, exactly as the command line would.
-    """
-    # The two subcommands a recipe runs, not evorbc-evolve's whole parser: that one holds
-    # the recipe command, which imports this module.
-    from offline_evolution.commands import arbitrator, repertoire
-    from sim_bridge.cli_support import OneLineParser
-
-    parser = OneLineParser(prog="evorbc-evolve")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    repertoire.add_parsers(sub)
-    arbitrator.add_parsers(sub)
-    args: argparse.Namespace = parser.parse_args(argv)
-    args.func(args)
+    return ArbitratorRun(
+        kind=EVORBC,
+        repertoire=step.repertoire_file or str(out / recipe.step(step.repertoire).out),
+        seed=step.seed,
+        generations=generations,
+        out=str(target),
+        **{key: str(path) for key, path in files.items() if path is not None},
+        init_from=init,
+    )

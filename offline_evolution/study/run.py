@@ -1,15 +1,18 @@
-"""One run of a study: ordinary ``evorbc-evolve`` commands in the run's own folder.
+"""One run of a study: the ordinary repertoire and arbitrator runs in the run's own folder.
 
 A run folder (``RESULTS/<setting>/seed-NNN/``) holds, when the run is finished:
 
 * ``repertoire.json.xz`` (EvoRBC runs): the ``evorbc-evolve repertoire`` file;
 * ``arbitrator.json.xz``: the ``evorbc-evolve arbitrator`` or ``standard`` file, with the
   per-generation fitness history;
-* ``run.json``: the run's settings and seed, the commands, the measured cost (wall and CPU
-  seconds, host, threads) and a summary. It is written last, atomically: a run is finished
-  exactly when it exists, and the folder is the single record of the run.
+* ``run.json``: the run's settings and seed, the equivalent ``evorbc-evolve`` commands,
+  the measured cost (wall and CPU seconds, host, threads) and a summary. It is written
+  last, atomically: a run is finished exactly when it exists, and the folder is the
+  single record of the run.
 
-While a run is under way the folder holds the commands' own checkpoints
+Each step runs the run API (:mod:`offline_evolution.runs`) in a worker process of its own
+(:mod:`offline_evolution.runs.worker`), so that it can be stopped, killed or lost alone
+and its CPU time counted. While a run is under way the folder holds the steps' checkpoints
 (``*.checkpoint.*``); running the same run again resumes from them, so a run killed at any
 point loses at most the work since its last checkpoint and then gives the same files as a
 run that was never interrupted (the commands are seeded and resume bit for bit).
@@ -36,17 +39,17 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from evorbc_ros.atomic_io import atomic_write, special_file_kind
-from offline_evolution.study.spec import Run
+from offline_evolution.runs.errors import EXIT_INTERRUPTED
+from offline_evolution.runs.worker import spec
+from offline_evolution.study.spec import REPERTOIRE_KEYS, Run
 from sim_bridge.cluster_pool import CLUSTER_VARIABLE
 
 RUN_FILE = "run.json"
 FORMAT = "evorbc-study-run"
 VERSION = 1
-#: ``evorbc-evolve`` as a command; -P: never import the checkout's ROS package folders
+#: The worker process of a step; -P: never import the checkout's ROS package folders
 #: from the current folder (docs/design.md section 10).
-CLI = (sys.executable, "-P", "-m", "offline_evolution.cli")
-#: Exit status of ``evorbc-evolve`` after Ctrl-C/SIGTERM: the checkpoint is saved.
-EXIT_INTERRUPTED = 130
+WORKER = (sys.executable, "-P", "-m", "offline_evolution.runs.worker")
 
 
 class RunError(Exception):
@@ -101,42 +104,77 @@ def check_settings(run: Run, folder: Path) -> None:
         )
 
 
-def commands(run: Run, folder: Path, workers: int | None = None) -> list[list[str]]:
-    """The ``evorbc-evolve`` command lines of ``run`` (relative to ``folder``).
+def steps(run: Run) -> list:
+    """The runs (``RepertoireRun``, ``ArbitratorRun``) of ``run``, in order.
 
-    Only the keys the setting names are passed; everything else comes from the robot's
-    shipped settings files (Table I), as for any run started by hand. ``workers`` caps a
-    PyBullet robot's simulation processes (``--workers``; the 4WS kernels ignore it), so
-    a run takes the CPUs it was given and no more.
+    Only the keys the setting names are given; everything else comes from the robot's
+    shipped settings files (Table I), as for any run started by hand. Outputs are
+    relative to the run's folder; the fitness curve goes to a scratch name that is
+    removed once the run is finished (the study report draws its own figures from the
+    histories).
     """
+    from evorbc_ros.controller_kinds import EVORBC, STANDARD
+    from offline_evolution.runs.arbitrator import ArbitratorRun
+    from offline_evolution.runs.repertoire import RepertoireRun
+
     v = run.values
-    cli = list(CLI)
-    seed = ["--seed", str(run.seed)]
-    out = []
-    if run.approach == "evorbc":
-        rep = [*cli, "repertoire", "--robot", v["robot"], *seed, "--out", "repertoire.json"]
-        for key in ("metric", "bin_size", "eval_time", "initial_batch", "batch_size"):
-            if key in v:
-                rep += [f"--{key.replace('_', '-')}", str(v[key])]
-        for key in ("iterations", "archive", "variation"):
-            if key in v:
-                rep += [f"--{key}", str(v[key])]
-        out.append([*rep, "--quiet"])
-        arb = [*cli, "arbitrator", "--repertoire", "repertoire.json", *seed]
-        if "mapping" in v:
-            arb += ["--mapping", v["mapping"]]
-    else:
-        arb = [*cli, "standard", "--robot", v["robot"], *seed]
-        if v.get("equal_budget"):
-            arb.append("--equal-budget")
-    if "generations" in v:
-        arb += ["--generations", str(v["generations"])]
-    # The fitness curve goes to a scratch name that is removed once the run is finished:
-    # the study report draws its own figures from the histories.
-    out.append([*arb, "--out", "arbitrator.json", "--plot", "fitness-curve.png", "--quiet"])
-    if workers:
-        out = [[*cmd, "--workers", str(workers)] for cmd in out]
-    return out
+    given = {k: _TYPES[k](v[k]) for k in _TYPES if k in v}
+    plot = "fitness-curve.png"
+    if run.approach != "evorbc":
+        return [
+            ArbitratorRun(
+                kind=STANDARD,
+                robot=v["robot"],
+                seed=run.seed,
+                equal_budget=bool(v.get("equal_budget")),
+                generations=given.get("generations"),
+                out="arbitrator.json",
+                plot=plot,
+            )
+        ]
+    repertoire = RepertoireRun(
+        robot=v["robot"],
+        seed=run.seed,
+        out="repertoire.json",
+        **{k: given[k] for k in REPERTOIRE_KEYS if k in given},
+    )
+    arbitrator = ArbitratorRun(
+        kind=EVORBC,
+        repertoire="repertoire.json",
+        seed=run.seed,
+        mapping=given.get("mapping"),
+        generations=given.get("generations"),
+        out="arbitrator.json",
+        plot=plot,
+    )
+    return [repertoire, arbitrator]
+
+
+#: Setting key -> its type in the run settings (the study file holds checked values).
+_TYPES = {
+    "metric": str,
+    "bin_size": float,
+    "eval_time": float,
+    "initial_batch": int,
+    "batch_size": int,
+    "iterations": int,
+    "archive": str,
+    "variation": str,
+    "mapping": str,
+    "generations": int,
+}
+
+
+def commands(run: Run, workers: int | None = None) -> list[list[str]]:
+    """The ``evorbc-evolve`` arguments equivalent to the steps of ``run`` (its record).
+
+    ``workers`` caps a PyBullet robot's simulation processes (``--workers``; the 4WS
+    kernels ignore it), so a run takes the CPUs it was given and no more.
+    """
+    from offline_evolution.runs.command_line import command_line
+
+    tail = ["--quiet"] + (["--workers", str(workers)] if workers else [])
+    return [[*command_line(step), *tail] for step in steps(run)]
 
 
 #: Every file a run writes in its folder (the commands' outputs, checkpoints and log).
@@ -269,27 +307,26 @@ def execute(run: Run, results: Path, threads: int = 1, cluster: str | None = Non
     env.pop(CLUSTER_VARIABLE, None)
     if cluster:
         env[CLUSTER_VARIABLE] = cluster
+    workers = None if cluster else threads
     with open(folder / "run.log", "a", encoding="utf-8") as log:
-        for cmd in commands(run, folder, None if cluster else threads):
-            target = folder / cmd[cmd.index("--out") + 1]
+        for step, cmd in zip(steps(run), commands(run, workers), strict=True):
+            target = folder / step.out
             if target.exists() or target.with_name(target.name + ".xz").exists():
                 continue  # finished by an earlier attempt
-            log.write(f"$ evorbc-evolve {' '.join(cmd[len(CLI) :])}\n")
+            log.write(f"$ evorbc-evolve {' '.join(cmd)}\n")
             log.flush()
-            status, asked = _run_command(cmd, folder, env, log)
+            status, asked = _run_step([*WORKER, spec(step, workers, quiet=True)], folder, env, log)
             if status < 0 and not asked:
                 # A crash (SIGSEGV), the OOM killer (SIGKILL) or someone's kill: a failed
                 # run, not a stop the study asked for (docs/design.md section 15).
                 raise RunError(
-                    f"run {run.path}: {cmd[len(CLI)]} died of signal {died_of_signal(status)}; "
+                    f"run {run.path}: {cmd[0]} died of signal {died_of_signal(status)}; "
                     f"its checkpoint, if any, is kept; see {folder / 'run.log'}"
                 )
             if status == EXIT_INTERRUPTED or status < 0:
                 raise RunInterrupted(str(run.path))
             if status != 0:
-                raise RunError(
-                    f"{run.path}: {cmd[len(CLI)]} failed (status {status}): {_tail(folder)}"
-                )
+                raise RunError(f"{run.path}: {cmd[0]} failed (status {status}): {_tail(folder)}")
     for name in ("repertoire.json", "arbitrator.json"):
         if (folder / name).exists():
             _xz(folder / name)
@@ -299,7 +336,7 @@ def execute(run: Run, results: Path, threads: int = 1, cluster: str | None = Non
         "format": FORMAT,
         "version": VERSION,
         "settings": run.recorded_settings(),
-        "commands": [" ".join(["evorbc-evolve", *c[len(CLI) :]]) for c in commands(run, folder)],
+        "commands": [" ".join(["evorbc-evolve", *c]) for c in commands(run)],
         "seconds": round(wall, 3),
         "cpu_seconds": round(cpu, 3),
         "threads": threads,
@@ -314,8 +351,8 @@ def execute(run: Run, results: Path, threads: int = 1, cluster: str | None = Non
     return RunRecord.load(folder)
 
 
-def _run_command(cmd: list[str], folder: Path, env: dict, log) -> tuple[int, bool]:
-    """Run one command to its end; add its wall and CPU time to the run's tally.
+def _run_step(cmd: list[str], folder: Path, env: dict, log) -> tuple[int, bool]:
+    """Run one step's worker process to its end; add its wall and CPU time to the tally.
 
     Returns:
         The exit status (negative: killed by that signal), and whether the runner asked

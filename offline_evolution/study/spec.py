@@ -22,21 +22,14 @@ from typing import Any
 
 from evorbc_ros.config import ConfigError, config_dir, load_yaml_mapping
 from offline_evolution import bounds
+from offline_evolution.runs import repertoire as repertoire_runs
 
 #: The two approaches the paper compares (Sec. IV-C).
 APPROACHES = ("evorbc", "standard")
 
-#: Keys of a run setting. Repertoire keys apply to EvoRBC runs only.
-REPERTOIRE_KEYS = (
-    "metric",
-    "bin_size",
-    "eval_time",
-    "initial_batch",
-    "batch_size",
-    "iterations",
-    "archive",
-    "variation",
-)
+#: Keys of a run setting. Repertoire keys apply to EvoRBC runs only: a repertoire run's
+#: settings but its robot and seed, which every run has.
+REPERTOIRE_KEYS = tuple(k for k in repertoire_runs.SETTING_KEYS if k not in ("robot", "seed"))
 ARBITRATOR_KEYS = ("mapping", "generations")
 STANDARD_KEYS = ("generations", "equal_budget")
 SETTING_KEYS = ("approach", "robot", *REPERTOIRE_KEYS, *ARBITRATOR_KEYS, "equal_budget")

@@ -15,6 +15,7 @@ The public API (``n`` primitives; lengths in m, angles in rad):
   ``config/mazes/`` or a file.
 """
 
+import evorbc_ros
 from evorbc_ros.lazy_exports import lazy_exports
 from evorbc_ros.numba_caches import drop_stale_caches
 
@@ -26,5 +27,5 @@ _EXPORTS = {
 }
 __all__ = sorted(_EXPORTS)
 # Caches left by an earlier version whose modules have moved break numba (see numba_caches).
-drop_stale_caches(__path__[0])
+drop_stale_caches(__path__[0], evorbc_ros.__path__[0])
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -1,0 +1,221 @@
+"""An evaluation run: a controller on a suite of mazes, from many starts, perturbed.
+
+:func:`evaluate_run` is what ``evorbc-evolve evaluate`` does, without its console: the
+suite gathered (training mazes, files, folders, generated held-out mazes), the memory
+estimate, the episodes from seeded random starts in perturbed worlds, the report written
+atomically, and the suite's picture (docs/design.md section 21).
+"""
+
+from __future__ import annotations
+
+import json
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from evorbc_ros.arbitrator import ArbitratorFile
+from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.config import ConfigError
+from evorbc_ros.defaults import (
+    PAPER_WITH_FILE,
+    default_arbitrator,
+    no_shipped_controller,
+    paper_arbitrator,
+    ships_controller,
+)
+from evorbc_ros.robots.registry import DEFAULT_ROBOT
+from offline_evolution.mazes.held_out import HELD_OUT_SEED  # never trained on
+from offline_evolution.reporters import Reporter, Reporters
+from offline_evolution.runs.errors import UserError
+from offline_evolution.runs.outputs import check_distinct, check_outputs, exclusive_outputs
+from offline_evolution.runs.replay import check_task, controller_inputs
+
+#: The suite word for the mazes the controller was trained on (its task's mazes).
+PAPER = "paper"
+
+
+@dataclass(frozen=True, kw_only=True)
+class EvaluateRun:
+    """What to evaluate on which suite (``evorbc-evolve evaluate``'s options)."""
+
+    arbitrator: str | None = None  # default: the shipped one for robot
+    robot: str = DEFAULT_ROBOT
+    paper: bool = False  # the shipped paper-protocol controller
+    repertoire: str | None = None  # default: the one it names, next to it, or the shipped
+    mazes: Sequence[str] | None = None  # PAPER, maze names, files or folders
+    generated: int | None = None  # mazes generated for the robot, added to the suite
+    generated_seed: int = HELD_OUT_SEED
+    starts: int = 20  # random starts per maze
+    seed: int = 0  # of the starts and worlds
+    perturb: str = "none"  # perturbation set: a shipped one or a file
+    task: str | None = None  # task settings (episode time, sensors)
+    plot: str | None = None  # picture of the suite (PNG)
+    out: str | None = None  # the report (JSON)
+    allow_mismatch: bool = False  # another repertoire fingerprint or sensor layout
+
+
+@dataclass(frozen=True)
+class EvaluateOutcome:
+    """A finished evaluation: its report (as ``--out`` writes it) and what it ran."""
+
+    report: dict  # per maze, overall and per episode
+    path: Path  # of the arbitrator file
+    arbitrator: ArbitratorFile
+    perturbation: str  # the set's name
+
+
+def evaluate_run(run: EvaluateRun, reporters: Sequence[Reporter] = ()) -> EvaluateOutcome:
+    """Evaluate; write the report (``run.out``) and the suite's picture (``run.plot``).
+
+    Args:
+        run: the settings.
+        reporters: told of warnings (a waived mismatch, perturbations the robot's
+            simulation cannot model) and of episodes (``episodes_done``; legged robots).
+
+    Raises:
+        UserError: a bad option, combination or output (one line).
+        ConfigError, RepertoireError, ArbitratorError: a bad input file.
+    """
+    written = {"--plot": run.plot, "--out": run.out}
+    check_outputs(written)
+    check_distinct(written)
+    with exclusive_outputs(written):
+        return _evaluate(run, Reporters(reporters))
+
+
+def _evaluate(run: EvaluateRun, report: Reporters) -> EvaluateOutcome:
+    """:func:`evaluate_run` once its outputs are checked and locked."""
+    from offline_evolution.maze_task.evaluation import evaluate_suite
+    from offline_evolution.maze_task.perturbation import load_perturbations
+
+    perturbation = load_perturbations(run.perturb)
+    arb, arb_path = load_arbitrator(run)
+    repertoire, rep_path, base = controller_inputs(arb, arb_path, run, report)
+    task = _suite_task(run, arb, base)
+    try:
+        check_task(task, arb, arb_path, repertoire, rep_path, run.allow_mismatch)
+        controller = task.controller(arb.kind, repertoire, arb.mapping)
+        task.progress = report.episodes_done  # PyBullet suites take minutes
+        try:
+            suite = evaluate_suite(
+                task, arb.network, controller, run.starts, run.seed, perturbation
+            )
+        except ValueError as e:
+            raise UserError(f"--perturb {run.perturb}: {e}") from None
+    finally:
+        task.close()
+    if suite.not_applicable:
+        report.warning(
+            f"--perturb {perturbation.name}: {arb.robot}'s simulation cannot model "
+            f"{', '.join(suite.not_applicable)}; applied: {', '.join(suite.applied) or 'nothing'}"
+        )
+    data = {
+        "arbitrator": str(arb_path),
+        "kind": arb.kind.name,
+        "robot": arb.robot,
+        "repertoire": rep_path,
+        "mazes": [m.name for m in task.mazes],
+        "generated": (
+            {"count": run.generated, "seed": run.generated_seed} if run.generated else None
+        ),
+        "starts_per_maze": run.starts,
+        "seed": run.seed,
+        "episode_time": base.episode_time,
+        "perturbation": perturbation.as_dict(),
+        "applied": list(suite.applied),
+        "not_applicable": list(suite.not_applicable),
+        "per_maze": suite.per_maze(),
+        "overall": suite.overall(),
+        "episodes": [e.as_dict() for e in suite.episodes],
+    }
+    if run.out:
+        atomic_write_text(run.out, json.dumps(data, indent=1) + "\n")
+    if run.plot:
+        _plot(task, suite, run.plot, f"{arb_path.name}, perturbations: {perturbation.name}")
+    return EvaluateOutcome(data, arb_path, arb, perturbation.name)
+
+
+def _suite_task(run: EvaluateRun, arb: ArbitratorFile, base):
+    """The task of the suite (mazes generated into a folder that is gone once loaded)."""
+    from offline_evolution.maze_task.base import MazeTaskSettings
+    from offline_evolution.maze_task.task import CONTROL_PERIOD, make_task
+    from offline_evolution.memory import check_replay_memory
+    from sim_bridge.robots.base import control_steps
+
+    with tempfile.TemporaryDirectory(prefix="evorbc-suite-") as tmp:
+        names = suite_mazes(run.mazes, base.mazes, bool(run.generated))
+        # Checked before the mazes are generated, which takes about 0.1 s each.
+        check_replay_memory(
+            (len(names) + (run.generated or 0)) * run.starts,
+            control_steps(base.episode_time, CONTROL_PERIOD),
+            len(arb.network.output_keys),
+            arb.robot,
+            f"episode_time {base.episode_time} s; --starts {run.starts}",
+        )
+        if run.generated:
+            names += _generated_files(arb.robot, run.generated, run.generated_seed, Path(tmp))
+        settings = MazeTaskSettings(tuple(names), base.episode_time, 1, base.sensors)
+        try:
+            return make_task(settings, arb.robot)
+        except ConfigError as e:
+            raise UserError(f"--mazes: {e}") from None
+
+
+def suite_mazes(given: list[str] | None, trained: tuple[str, ...], generated: bool) -> list[str]:
+    """Maze names and files of the suite, in order; folders give their ``*.yaml`` sorted."""
+    if not given:
+        return [] if generated else list(trained)
+    out = []
+    for item in given:
+        if item == PAPER:
+            out += trained
+        elif Path(item).is_dir():
+            files = sorted(str(f) for f in Path(item).glob("*.yaml"))
+            if not files:
+                raise UserError(f"--mazes {item}: the folder holds no .yaml maze files")
+            out += files
+        else:
+            out.append(item)
+    return out
+
+
+def load_arbitrator(run: EvaluateRun) -> tuple[ArbitratorFile, Path]:
+    """The arbitrator to evaluate and its path."""
+    if run.arbitrator and run.paper:
+        raise UserError(PAPER_WITH_FILE)
+    if run.arbitrator:
+        path = Path(run.arbitrator)
+    else:
+        if not ships_controller(run.robot):
+            raise UserError(f"{no_shipped_controller(run.robot)}; pass --arbitrator FILE")
+        path = (paper_arbitrator if run.paper else default_arbitrator)(run.robot)
+    return ArbitratorFile.load(path), path
+
+
+def _generated_files(robot: str, n: int, seed: int, folder: Path) -> list[str]:
+    """Generate ``n`` mazes of ``seed`` for ``robot`` into ``folder``; their files."""
+    from offline_evolution.mazes.files import save_maze
+    from offline_evolution.mazes.generator import generate_maze, spec_for_robot
+
+    spec = spec_for_robot(robot)
+    files = []
+    for k in range(n):
+        maze = generate_maze(spec, seed, k).maze
+        path = folder / f"{maze.name}.yaml"
+        save_maze(maze, path)
+        files.append(str(path))
+    return files
+
+
+def _plot(task, suite, path: str, title: str) -> None:
+    from offline_evolution.plots.suite import plot_suite
+
+    names = [m.name for m in task.mazes]
+    paths = [
+        [p for p, e in zip(suite.paths, suite.episodes, strict=True) if e.maze == n] for n in names
+    ]
+    reached = [[e.reached for e in suite.episodes if e.maze == n] for n in names]
+    rows = {r["maze"]: r for r in suite.per_maze()}
+    titles = [f"{n}: {rows[n]['reached']}/{rows[n]['episodes']} reached" for n in names]
+    plot_suite(task.mazes, path, titles=titles, paths=paths, reached=reached, title=title)
