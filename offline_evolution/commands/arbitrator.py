@@ -203,7 +203,7 @@ def _run(args, settings, every: int, repertoire, checkpoint: Path, initial_netwo
 
 def cmd_evolve(args: argparse.Namespace) -> int:
     """Evolve an arbitrator or a standard-NEAT controller and write its file and curve."""
-    from evorbc_ros.config import config_dir
+    from evorbc_ros.config import ConfigError, config_dir
     from evorbc_ros.sensors import SensorLayout
     from offline_evolution.arbitrator.evolve import (
         EvolutionSettings,
@@ -213,10 +213,10 @@ def cmd_evolve(args: argparse.Namespace) -> int:
     from offline_evolution.arbitrator.neat_config import load_neat_config
     from offline_evolution.arbitrator.settings import load_run_settings
     from offline_evolution.arbitrator.warm_start import load_initial_network, network_fingerprint
+    from offline_evolution.maze_task.base import fit_task_mazes
     from offline_evolution.maze_task.task import MazeTaskSettings, make_task
     from offline_evolution.maze_task.training import check_training
     from offline_evolution.memory import check_evolution_memory
-    from sim_bridge.maze import load_named_maze
 
     # Every output is checked before any work, so that a typo costs nothing.
     check_output_file(args.out, "--out")
@@ -241,14 +241,16 @@ def cmd_evolve(args: argparse.Namespace) -> int:
         generations += lookup(robot).equal_budget_generations
     neat_file = Path(args.neat_config) if args.neat_config else run.neat_path()
     task_settings = MazeTaskSettings.load(args.task or run.task_path())
+    # A maze the robot does not fit is scaled to fit it (one warning line), and the scale
+    # recorded with the task; a maze no scale fits is refused before any work.
+    try:
+        task_settings, task_mazes = fit_task_mazes(
+            task_settings, lookup(robot).footprint_radius, robot
+        )
+    except ConfigError as e:
+        raise CliError(f"{args.task or run.task_path()}: {e}") from None
     # Held-out mazes and seeds are refused before any work (docs/design.md section 22).
-    task_mazes = [load_named_maze(n) for n in task_settings.mazes]
     check_training(task_mazes, task_settings.training, args.seed, str(args.task or run.task_path()))
-    # Every nominal start must clear the robot's footprint (replay and the bridge use it).
-    for maze in task_mazes:
-        misfit = maze.start_misfit(lookup(robot).footprint_radius, robot)
-        if misfit:
-            raise CliError(f"{args.task or run.task_path()}: mazes: {misfit}")
     # The NEAT settings, the task's sensor layout and a network to start from, before any
     # work.
     layout = SensorLayout.load(config_dir() / task_settings.sensors)
