@@ -192,6 +192,8 @@ def _evaluate(args: argparse.Namespace) -> int:
         "robot": arb.robot,
         "repertoire": rep_path,
         "mazes": [m.name for m in task.mazes],
+        # Each maze's factor when one was scaled up to fit the robot (docs/design.md s. 21).
+        **({"maze_scale": list(task.settings.maze_scale)} if task.settings.maze_scale else {}),
         "generated": (
             {"count": args.generated, "seed": args.generated_seed} if args.generated else None
         ),

@@ -15,7 +15,8 @@ and the target with its radius, so every distance grows by ``s`` and nothing els
 changes. Since clearances scale with ``s``, ``s`` is read off the unscaled maze:
 ``max(r / c_start, 2 * MARGIN_RATIO * r / g)`` for the start's clearance ``c_start`` and the
 narrowest gap ``g`` on the widest route (which the grid search reads low by up to a cell,
-so ``s`` errs on the large side), rounded up to 0.001.
+so ``s`` errs on the large side), rounded up to 0.001. A maze walled shut (no route at
+any width, as a test of a wall stopping the robot) is scaled for its start only.
 """
 
 from __future__ import annotations
@@ -52,13 +53,15 @@ def fit_scale(maze: Maze, robot_radius: float) -> float:
 
     Returns:
         1.0 exactly if the maze fits as it is, else the factor (see the module docstring).
-        ``math.inf`` if no scale helps (the start or target inside a wall, or walls that
-        close the way whatever the size).
+        ``math.inf`` if no scale helps (the start inside a wall). A maze with no way from
+        the start region to the target at all is scaled for its start only.
     """
     start_room, gap = _room(maze)
-    if start_room <= 0 or gap <= 0:
+    if start_room <= 0:
         return math.inf
-    need = max(robot_radius / start_room, 2.0 * MARGIN_RATIO * robot_radius / gap)
+    need = robot_radius / start_room
+    if gap > 0:  # a maze walled shut (a test of a wall stopping the robot) scales for its start
+        need = max(need, 2.0 * MARGIN_RATIO * robot_radius / gap)
     if need <= 1.0:
         return 1.0
     return math.ceil(need * 1000.0 - 1e-9) / 1000.0
@@ -91,7 +94,7 @@ def misfit_reason(maze: Maze, robot_radius: float) -> str:
     """Why ``maze`` as it is does not fit (for the warning): what sets the factor."""
     start_room, gap = _room(maze)
     margin = MARGIN_RATIO * robot_radius
-    if robot_radius / start_room >= 2.0 * margin / gap:
+    if gap <= 0 or robot_radius / start_room >= 2.0 * margin / gap:
         return (
             f"its start is {start_room:.3f} m from a wall and the robot needs {robot_radius:.3f} m"
         )
@@ -116,8 +119,7 @@ def fitted_maze(
         factor = fit_scale(maze, robot_radius)
     if not math.isfinite(factor):
         raise ValueError(
-            f"maze {maze.name}: no scale fits robot {robot} (its start or target touches "
-            "a wall, or walls close the way)"
+            f"maze {maze.name}: no scale fits robot {robot} (its start touches a wall)"
         )
     if factor == 1.0:
         return maze, 1.0, None
