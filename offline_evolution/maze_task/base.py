@@ -87,20 +87,7 @@ class MazeTaskSettings:
             ConfigError: naming the file and the key, for any bad setting (see
                 :meth:`from_dict`).
         """
-        values = load_yaml_mapping(path)
-        source = str(path)
-        if isinstance(values.get("sensors"), str):
-            values["sensors"] = resolve_beside(
-                values["sensors"], source, "sensors", config_dir(), config_dir()
-            )
-        if isinstance(values.get("mazes"), list):
-            values["mazes"] = [
-                resolve_beside(m, source, f"mazes[{k}]", Path.cwd())
-                if isinstance(m, str) and is_maze_file(m)
-                else m
-                for k, m in enumerate(values["mazes"])
-            ]
-        return cls.from_dict(values, source)
+        return cls.from_dict(task_file_values(path), str(path))
 
     @classmethod
     def from_dict(cls, values: dict, source: str) -> MazeTaskSettings:
@@ -164,6 +151,30 @@ class MazeTaskSettings:
         if self.maze_scale is not None:
             out["maze_scale"] = list(self.maze_scale)
         return out
+
+
+def task_file_values(path: str | os.PathLike) -> dict:
+    """A task file's mapping with its relative paths resolved beside it.
+
+    ``sensors`` as recorded tasks name it (relative to ``config/`` within the checkout,
+    else absolute), maze files absolute, maze names as they are; an old location (``config/``
+    for ``sensors``, the working directory for maze files) still works with a deprecation
+    line (:func:`~evorbc_ros.settings_paths.resolve_beside`).
+    """
+    values = load_yaml_mapping(path)
+    source = str(path)
+    if isinstance(values.get("sensors"), str):
+        values["sensors"] = resolve_beside(
+            values["sensors"], source, "sensors", config_dir(), config_dir()
+        )
+    if isinstance(values.get("mazes"), list):
+        values["mazes"] = [
+            resolve_beside(m, source, f"mazes[{k}]", Path.cwd())
+            if isinstance(m, str) and is_maze_file(m)
+            else m
+            for k, m in enumerate(values["mazes"])
+        ]
+    return values
 
 
 def fit_task_mazes(
