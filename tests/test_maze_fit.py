@@ -238,12 +238,17 @@ def test_task_paths_resolve_beside_the_file_and_the_old_location_warns(tmp_path,
         f"taken from {config_dir()} (deprecated: relative paths in settings files are from "
         "the file's folder)"
     ]
-    # The shipped files name their neighbours beside them and record what they did.
+    # The shipped files name their neighbours from config/, without a line; a copy of one
+    # still works, with the line.
     shipped = MazeTaskSettings.load(config_dir() / "tasks" / "maze-4ws.yaml")
     assert shipped.sensors == "sensors/4ws.yaml"
     run = load_run_settings(config_dir() / "arbitrator" / "4ws.yaml")
     assert run.task_path() == config_dir() / "tasks" / "maze-4ws.yaml"
     assert capsys.readouterr().err == ""
+    copy = tmp_path / "run.yaml"
+    copy.write_text((config_dir() / "arbitrator" / "4ws.yaml").read_text())
+    assert load_run_settings(copy).task_path() == config_dir() / "tasks" / "maze-4ws.yaml"
+    assert capsys.readouterr().err.count("is not beside this file") == 2  # neat, task
     # A missing file is named where it was looked for.
     (tmp_path / "missing.yaml").write_text("mazes: [gaps]\nsensors: nope.yaml\n")
     from evorbc_ros.config import ConfigError

@@ -199,10 +199,9 @@ def fit_task_mazes(
     recorded = settings.maze_scale or (None,) * len(settings.mazes)
     mazes, factors = [], []
     for name, factor in zip(settings.mazes, recorded, strict=True):
+        loaded = load_named_maze(name)  # its own errors name the maze already
         try:
-            maze, factor_used, warning = fitted_maze(
-                load_named_maze(name), footprint_radius, robot, factor
-            )
+            maze, factor_used, warning = fitted_maze(loaded, footprint_radius, robot, factor)
         except ValueError as e:
             raise ConfigError(f"mazes: {e}") from None
         if warning and factor is None:

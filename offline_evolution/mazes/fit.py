@@ -25,7 +25,9 @@ import dataclasses
 import math
 
 import numpy as np
+from scipy.ndimage import distance_transform_edt
 
+from sim_bridge.geometry import box_corners, box_distances
 from sim_bridge.maze import Maze
 
 from .paths import narrowest_gap
@@ -35,13 +37,44 @@ MARGIN_RATIO = 1.2
 #: Grid cells across the maze's longer side at most, for the gap search (m per cell:
 #: 0.01 for mazes up to 20 m, the shipped ones being 8-11 m).
 _MAX_CELLS = 2000
+#: Cell-wall distance tests the exact gap search may make (about a second; the shipped
+#: mazes take 3 M); a maze beyond it is searched on :func:`_raster_clearance`.
+_EXACT_WORK = 50_000_000
+
+
+def _raster_clearance(maze: Maze, cell: float):
+    """``(xs, ys, clearance)`` on a grid, each wall visiting only the cells by it.
+
+    Cells within ``2 * cell`` of a wall's box hold their exact distance; the rest the
+    distance (m) to the nearest such cell plus ``2 * cell``, by a Euclidean distance
+    transform: a maze of thousands of walls costs its cells, not cells times walls.
+    """
+    x0, y0, x1, y1 = maze.bounds()
+    xs = x0 + (np.arange(math.ceil((x1 - x0) / cell)) + 0.5) * cell
+    ys = y0 + (np.arange(math.ceil((y1 - y0) / cell)) + 0.5) * cell
+    near = np.full((len(ys), len(xs)), np.inf)
+    reach = 2.0 * cell
+    for box, corners in zip(maze.boxes, box_corners(maze.boxes), strict=True):
+        lo, hi = corners.min(axis=0) - reach, corners.max(axis=0) + reach
+        i0, i1 = np.searchsorted(xs, lo[0]), np.searchsorted(xs, hi[0])
+        j0, j1 = np.searchsorted(ys, lo[1]), np.searchsorted(ys, hi[1])
+        gx, gy = np.meshgrid(xs[i0:i1], ys[j0:j1])
+        d = box_distances(gx, gy, box)
+        d[d > reach] = np.inf
+        np.minimum(near[j0:j1, i0:i1], d, out=near[j0:j1, i0:i1])
+    far = distance_transform_edt(~np.isfinite(near)) * cell + reach
+    return xs, ys, np.where(np.isfinite(near), near, far)
 
 
 def _room(maze: Maze) -> tuple[float, float]:
     """``(start clearance m, narrowest gap m on the widest route)`` of ``maze`` as it is."""
     x, y, _ = maze.start_pose
     cell = max(0.01, max(maze.size()) / _MAX_CELLS)
-    return maze.clearance(x, y), narrowest_gap(maze, cell)
+    cells = math.ceil(maze.size()[0] / cell) * math.ceil(maze.size()[1] / cell)
+    grid = None
+    if cells * len(maze.walls) > _EXACT_WORK:
+        grid = _raster_clearance(maze, cell)
+    return maze.clearance(x, y), narrowest_gap(maze, cell, grid=grid)
 
 
 def fit_scale(maze: Maze, robot_radius: float) -> float:
