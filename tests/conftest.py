@@ -110,8 +110,12 @@ def small_task_file(tmp_path):
     """A two-maze, 15 s task file."""
     import yaml
 
+    from evorbc_ros.config import config_dir
+
     path = tmp_path / "task.yaml"
-    path.write_text(yaml.safe_dump(SMALL_TASK))
+    # Absolute: a relative path in a task file is from its folder (recorded from config/).
+    sensors = str(config_dir() / SMALL_TASK["sensors"])
+    path.write_text(yaml.safe_dump({**SMALL_TASK, "sensors": sensors}))
     return path
 
 

@@ -10,6 +10,7 @@ from pathlib import Path
 from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
 from evorbc_ros.mapping import MAPPINGS
 from evorbc_ros.robots.registry import DEFAULT_ROBOT, lookup
+from evorbc_ros.settings_paths import resolve_beside
 from offline_evolution import bounds
 from offline_evolution.arbitrator.selection import RULES
 
@@ -20,8 +21,8 @@ class ArbitratorRunSettings:
 
     generations: int = setting(doc="NEAT generations", minimum=1, maximum=bounds.GENERATIONS)
     mapping: str = setting("polar", doc="mapping function", choices=MAPPINGS)
-    neat: str = setting("neat/4ws.ini", doc="NEAT settings file, relative to config/")
-    task: str = setting("tasks/maze-4ws.yaml", doc="task settings file, relative to config/")
+    neat: str = setting("neat/4ws.ini", doc="NEAT settings file, from this file's folder")
+    task: str = setting("tasks/maze-4ws.yaml", doc="task settings file, from this file's folder")
     checkpoint_every: int = setting(10, doc="generations between checkpoints", minimum=1)
     hall_of_fame: int = setting(25, doc="genomes kept for the post-evaluation", minimum=1)
     post_samples: int = setting(
@@ -86,13 +87,15 @@ def load_run_settings(
 ) -> ArbitratorRunSettings:
     """Settings from ``path``, by default the arbitrator settings file of ``robot``.
 
-    Relative ``neat`` and ``task`` paths are from ``config/``; one found only beside this
-    file is taken from there, so a robot in its own package ships its settings together
-    (docs/your-robot.md).
+    Relative ``neat`` and ``task`` paths are from this file's folder, so a robot in its
+    own package ships its settings together (docs/your-robot.md); one found only where
+    they were taken from before (the working directory, then ``config/``) still works,
+    with a deprecation line (:func:`~evorbc_ros.settings_paths.resolve_beside`).
     """
     if path is None:
         path = lookup(robot).settings_file("arbitrator")
-    settings = build_settings(ArbitratorRunSettings, load_yaml_mapping(path), str(path))
+    values = load_yaml_mapping(path)
+    settings = build_settings(ArbitratorRunSettings, values, str(path))
     if (settings.post_finalists > 0) != (settings.post_final_samples > 0):
         # One without the other would run one round and say nothing.
         raise ConfigError(
@@ -100,17 +103,17 @@ def load_run_settings(
             f"a second post-selection round, or both 0 (got {settings.post_finalists} and "
             f"{settings.post_final_samples})"
         )
-    beside = {}
-    for key in ("neat", "task"):
-        name = getattr(settings, key)
-        local = Path(path).parent / name
-        if not _resolve(name).is_file() and local.is_file():
-            beside[key] = str(local.resolve())
+    old = (Path.cwd(), config_dir())
+    beside = {
+        key: resolve_beside(getattr(settings, key), path, key, old, config_dir())
+        for key in ("neat", "task")
+        if key in values
+    }
     settings = dataclasses.replace(settings, **beside)
     # The files it refers to, checked here so that an error names this file and key.
     for key, target in (("neat", settings.neat_path()), ("task", settings.task_path())):
         if not target.is_file():
             raise ConfigError(
-                f"{path}: {key}: no such file {target} (relative paths are from config/)"
+                f"{path}: {key}: no such file {target} (relative paths are from this file's folder)"
             )
     return settings

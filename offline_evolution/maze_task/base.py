@@ -18,9 +18,11 @@ Both implement :class:`~offline_evolution.task_protocol.ArbitratorTask`.
 from __future__ import annotations
 
 import abc
+import dataclasses
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -29,9 +31,10 @@ from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.sensors import SensorLayout
+from evorbc_ros.settings_paths import resolve_beside
 from offline_evolution.maze_task.training import TrainingMazes, TrainingSettings, check_training
 from offline_evolution.task_protocol import EpisodeResult
-from sim_bridge.maze import Maze, load_named_maze
+from sim_bridge.maze import Maze, is_maze_file, load_named_maze
 from sim_bridge.robots.base import control_steps
 
 #: s between the arbitrator's decisions, for the 4WS robots and the hexapod alike.
@@ -48,10 +51,19 @@ class MazeTaskSettings:
     mazes: tuple[str, ...] = setting(doc="maze names or files")
     episode_time: float = setting(120.0, doc="episode length T (s)", minimum=0.1)
     samples_per_maze: int = setting(1, doc="random starts per maze per evaluation", minimum=1)
-    sensors: str = setting("sensors/4ws.yaml", doc="sensor layout file, relative to config/")
+    sensors: str = setting(
+        "sensors/4ws.yaml",
+        doc="sensor layout file: in a task file, from the file's folder; as recorded, "
+        "relative to config/ or absolute",
+    )
     # A frozen dataclass: the default call is a field declaration, not a shared value.
     training: TrainingSettings | None = setting(  # noqa: RUF009
         None, doc="training on generated mazes (docs/design.md section 22); none: the paper's"
+    )
+    maze_scale: tuple[float, ...] | None = setting(
+        None,
+        doc="per maze, the factor it is scaled up by to fit the robot (docs/design.md "
+        "section 21); recorded by a run that scaled one; none: each maze as its file has it",
     )
 
     def __post_init__(self):
@@ -59,16 +71,23 @@ class MazeTaskSettings:
         if isinstance(self.training, dict):
             training = TrainingSettings.from_dict(self.training, "the task's training")
             object.__setattr__(self, "training", training)
+        if self.maze_scale is not None:  # a recorded list (``MazeTaskSettings(**task)``)
+            object.__setattr__(self, "maze_scale", tuple(float(f) for f in self.maze_scale))
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> MazeTaskSettings:
         """Settings from a task file (``config/tasks/*.yaml``).
 
+        Relative paths (``sensors``, maze files in ``mazes``) are from the file's folder
+        (:func:`~evorbc_ros.settings_paths.resolve_beside`; the old locations, ``config/``
+        for ``sensors`` and the working directory for maze files, still work with a
+        deprecation line). Maze names stay names (``config/mazes/``).
+
         Raises:
             ConfigError: naming the file and the key, for any bad setting (see
                 :meth:`from_dict`).
         """
-        return cls.from_dict(load_yaml_mapping(path), str(path))
+        return cls.from_dict(task_file_values(path), str(path))
 
     @classmethod
     def from_dict(cls, values: dict, source: str) -> MazeTaskSettings:
@@ -93,6 +112,14 @@ class MazeTaskSettings:
             raise ConfigError(f"{source}: episode_time {e}") from None
         if not settings.mazes:
             raise ConfigError(f"{source}: mazes must name at least one maze")
+        scale = settings.maze_scale
+        if scale is not None and (
+            len(scale) != len(settings.mazes) or not all(1.0 <= f <= 100.0 for f in scale)
+        ):
+            raise ConfigError(
+                f"{source}: maze_scale must be one factor in [1, 100] per maze "
+                f"({len(settings.mazes)}), got {list(scale)}"
+            )
         # The files the task refers to, checked here so that an error names this source.
         for name in settings.mazes:
             try:
@@ -102,7 +129,8 @@ class MazeTaskSettings:
         layout = config_dir() / settings.sensors
         if not layout.is_file():
             raise ConfigError(
-                f"{source}: sensors: no such file {layout} (the path is relative to config/)"
+                f"{source}: sensors: no such file {layout} (relative paths are from the "
+                "task file's folder)"
             )
         try:
             SensorLayout.load(layout)
@@ -111,7 +139,7 @@ class MazeTaskSettings:
         return settings
 
     def as_dict(self) -> dict:
-        """Plain-data form (recorded in arbitrator files); ``training`` only when set."""
+        """Plain-data form (recorded in arbitrator files); ``training``, ``maze_scale`` if set."""
         out = {
             "mazes": list(self.mazes),
             "episode_time": self.episode_time,
@@ -120,7 +148,72 @@ class MazeTaskSettings:
         }
         if self.training is not None:
             out["training"] = self.training.as_dict()
+        if self.maze_scale is not None:
+            out["maze_scale"] = list(self.maze_scale)
         return out
+
+
+def task_file_values(path: str | os.PathLike) -> dict:
+    """A task file's mapping with its relative paths resolved beside it.
+
+    ``sensors`` as recorded tasks name it (relative to ``config/`` within the checkout,
+    else absolute), maze files absolute, maze names as they are; an old location (``config/``
+    for ``sensors``, the working directory for maze files) still works with a deprecation
+    line (:func:`~evorbc_ros.settings_paths.resolve_beside`).
+    """
+    values = load_yaml_mapping(path)
+    source = str(path)
+    if isinstance(values.get("sensors"), str):
+        values["sensors"] = resolve_beside(
+            values["sensors"], source, "sensors", config_dir(), config_dir()
+        )
+    if isinstance(values.get("mazes"), list):
+        values["mazes"] = [
+            resolve_beside(m, source, f"mazes[{k}]", Path.cwd())
+            if isinstance(m, str) and is_maze_file(m)
+            else m
+            for k, m in enumerate(values["mazes"])
+        ]
+    return values
+
+
+def fit_task_mazes(
+    settings: MazeTaskSettings, footprint_radius: float, robot: str = "the robot"
+) -> tuple[MazeTaskSettings, list[Maze]]:
+    """The task's mazes, each scaled up to fit the robot, and the settings recording it.
+
+    A maze whose factor ``settings.maze_scale`` records is scaled by it; any other is
+    scaled by the smallest factor that fits (:func:`~offline_evolution.mazes.fit.fit_scale`,
+    docs/design.md section 21), with one warning line on stderr naming the maze, the factor
+    and why. The settings returned record every factor (``maze_scale``) when one is not 1,
+    else they are ``settings`` unchanged.
+
+    Raises:
+        ConfigError: no scale fits a maze, or a recorded scale leaves the robot's
+            footprint touching a wall at the maze's nominal start (replay, the
+            post-selection and the ROS bridge start there).
+    """
+    from evorbc_ros.robots.adapters import report
+    from offline_evolution.mazes.fit import fitted_maze
+
+    recorded = settings.maze_scale or (None,) * len(settings.mazes)
+    mazes, factors = [], []
+    for name, factor in zip(settings.mazes, recorded, strict=True):
+        loaded = load_named_maze(name)  # its own errors name the maze already
+        try:
+            maze, factor_used, warning = fitted_maze(loaded, footprint_radius, robot, factor)
+        except ValueError as e:
+            raise ConfigError(f"mazes: {e}") from None
+        if warning and factor is None:
+            report(warning)
+        misfit = maze.start_misfit(footprint_radius, robot)
+        if misfit:
+            raise ConfigError(f"mazes: {misfit}")
+        mazes.append(maze)
+        factors.append(factor_used)
+    if settings.maze_scale is None and any(f != 1.0 for f in factors):
+        settings = dataclasses.replace(settings, maze_scale=tuple(factors))
+    return settings, mazes
 
 
 def eq5_fitness(reached, seconds, final, initial, episode_time: float) -> np.ndarray:
@@ -171,15 +264,12 @@ class MazeTaskBase(abc.ABC):
         footprint_radius: float,
         robot_name: str = "the robot",
     ):
+        # A maze the robot does not fit is scaled up to fit it (a warning line, unless
+        # the scale is the recorded one): see :func:`fit_task_mazes`.
+        settings, mazes = fit_task_mazes(settings, footprint_radius, robot_name)
         self.settings = settings
         #: The task's own mazes (``settings.mazes``), always first in :attr:`mazes`.
-        self.task_mazes: tuple[Maze, ...] = tuple(load_named_maze(n) for n in settings.mazes)
-        # Replay, the post-selection and the ROS bridge start at a maze's nominal pose, so
-        # it must clear the footprint as random starts do (the bridge refuses it too).
-        for maze in self.task_mazes:
-            misfit = maze.start_misfit(footprint_radius, robot_name)
-            if misfit:
-                raise ConfigError(f"mazes: {misfit}")
+        self.task_mazes: tuple[Maze, ...] = tuple(mazes)
         #: The mazes episodes run in (start rows' maze column): the task's own, then the
         #: generated ones of the current draw (:meth:`generation_episodes`).
         self.mazes: list[Maze] = list(self.task_mazes)

@@ -109,32 +109,54 @@ class MazeSpec:
     path_limit: float  # longest shortest path from any start
     cell: float = 0.01  # grid of the path search
     wall_thickness: float = 0.01
+    scale: float = 1.0  # the robot's maze was scaled up this much to fit it
 
     @property
     def snap(self) -> float:
-        """How far (m) a start may step to the nearest free cell (its clearance: the footprint)."""
-        return self.margin - self.robot_radius + 0.01
+        """How far (m) a start may step to the nearest free cell (its clearance: the footprint).
+
+        One grid cell of 0.01 m beyond the margin's slack, that cell scaled with the maze.
+        """
+        return self.margin - self.robot_radius + 0.01 * self.scale
 
 
 @functools.lru_cache(maxsize=16)
 def spec_for_robot(name: str) -> MazeSpec:
     """The generator's settings for a registered robot, from its registration.
 
+    Sizes come from the robot's default maze, scaled up uniformly when the robot does not
+    fit it (:mod:`~offline_evolution.mazes.fit`: its start, or a route keeping 1.2 times the
+    footprint radius; one warning line on stderr), so corridors, gaps, openings, wall
+    lengths, the start region and the target radius all grow with the footprint. A robot
+    that fits its maze (every shipped robot) gets exactly the sizes of that maze. The
+    longest path allowed is at most 2/3 of what the robot drives at its top speed in an
+    episode; a scaled maze too long for that is shortened to it (docs/design.md section 21).
+
     Raises:
         ConfigError: the robot is unknown (naming the known ones), or its default maze
-            is not solvable with its footprint (nothing to scale new mazes from).
+            is not solvable with its footprint at any scale (nothing to size mazes from).
     """
+    from evorbc_ros.robots.adapters import report
     from evorbc_ros.robots.registry import lookup
 
+    from .fit import fitted_maze
+
     robot = lookup(name)
-    maze = load_named_maze(robot.maze)
+    own = load_named_maze(robot.maze)
     r = robot.footprint_radius
+    try:
+        maze, scale, warning = fitted_maze(own, r, name)
+    except ValueError as e:
+        raise ConfigError(f"robot {name}: {e}; cannot size generated mazes from it") from None
+    if warning:
+        report(f"generated mazes: {warning}")
     margin = 1.2 * r
-    cell = 0.01 if maze.size()[1] < 1.8 else 0.02  # m; the hexapod's 2 m maze needs less
+    # m; the hexapod's 2 m maze needs less. A scaled maze keeps its grid in cells.
+    cell = (0.01 if own.size()[1] < 1.8 else 0.02) * scale
     x0, y0, x1, y1 = maze.bounds()
     t = maze.wall_thickness
     inner_left, inner_h = x0 + t, (y1 - y0) - 2 * t
-    field_ = solve(maze, cell, margin, margin - r + 0.01)
+    field_ = solve(maze, cell, margin, margin - r + 0.01 * scale)
     path = field_.distance_from(*maze.start_pose[:2])
     if not math.isfinite(path):
         raise ConfigError(
@@ -143,9 +165,14 @@ def spec_for_robot(name: str) -> MazeSpec:
         )
     gap = narrowest_gap(maze, cell)
     height = round(inner_h, 3)
+    width = round((x1 - x0) - 2 * t, 3)
+    reach = 2.0 / 3.0 * robot.max_speed * robot.episode_time  # m driven in 2/3 of T
+    if scale > 1.0 and 1.1 * path > reach:
+        # A scaled-up maze the robot cannot cross in time: shorter by the same ratio.
+        width = round(width * reach / (1.1 * path), 3)
     return MazeSpec(
         robot=name,
-        width=round((x1 - x0) - 2 * t, 3),
+        width=width,
         height=height,
         robot_radius=r,
         margin=margin,
@@ -154,13 +181,17 @@ def spec_for_robot(name: str) -> MazeSpec:
         spacing=(max(0.6 * height, 1.2 * gap), max(1.1 * height, 2.0 * gap)),
         start_offset=maze.start_x[0] - inner_left,
         start_length=maze.start_x[1] - maze.start_x[0],
-        start_inset=max(0.0, min(maze.start_y[0] - (y0 + t), (y1 - t) - maze.start_y[1])),
+        # At least the margin: a start in a corner of the region, clear of both walls by the
+        # footprint, is then never more than the snap from a free cell (every shipped
+        # robot's region but the TurtleBot3's already is).
+        start_inset=max(0.0, min(maze.start_y[0] - (y0 + t), (y1 - t) - maze.start_y[1]), margin),
         start_heading_deg=tuple(math.degrees(h) for h in maze.start_heading),
         first_obstacle=maze.start_x[1] - inner_left + max(margin, 0.2),
         target_radius=maze.target_radius,
-        path_limit=min(1.1 * path, 2.0 / 3.0 * robot.max_speed * robot.episode_time),
+        path_limit=min(1.1 * path, reach),
         cell=cell,
         wall_thickness=t,
+        scale=scale,
     )
 
 

@@ -282,14 +282,15 @@ def wall_followers(maze: Maze, keep: float = FOLLOW) -> dict[str, float]:
     return out
 
 
-def narrowest_gap(maze: Maze, cell: float = 0.01, resolution: float = 0.001) -> float:
+def narrowest_gap(maze: Maze, cell: float = 0.01, resolution: float = 0.001, grid=None) -> float:
     """Width (m, wall surface to wall surface) of the narrowest gap on the widest route.
 
     Twice the largest clearance that still connects the start region to the target: the
     robot cannot avoid a gap this narrow, and need not pass a narrower one. Cell centres
     miss a gap's middle by up to half a cell each way, so this reads low by up to ``cell``.
+    ``grid``: the ``(xs, ys, clearance)`` to search, if not :func:`clearance_grid`'s.
     """
-    xs, ys, clear = clearance_grid(maze, cell)
+    xs, ys, clear = grid if grid is not None else clearance_grid(maze, cell)
     gx, gy = np.meshgrid(xs, ys)
     start = (
         (maze.start_x[0] <= gx)

@@ -18,8 +18,9 @@ from pathlib import Path
 import yaml
 
 from evorbc_ros.atomic_io import atomic_write_text
-from evorbc_ros.config import load_yaml_mapping
+from evorbc_ros.config import config_dir, load_yaml_mapping
 from offline_evolution.arbitrator.settings import load_run_settings
+from sim_bridge.maze import is_maze_file
 
 BUDGETS = ("full", "small")
 #: MAP-Elites: initial batch, batch size and iterations of the small budget.
@@ -93,8 +94,20 @@ def _small_neat(path: Path) -> str:
 
 
 def _small_task(path: Path) -> str:
-    """The task settings of ``path`` with short episodes and few generated mazes."""
-    data = load_yaml_mapping(path)
+    """The task settings of ``path`` with short episodes and few generated mazes.
+
+    Its paths, resolved beside ``path``, are written absolute: the copy lies elsewhere.
+    """
+    from offline_evolution.maze_task.base import task_file_values
+
+    data = task_file_values(path)
+    if isinstance(data.get("sensors"), str):
+        data["sensors"] = str(config_dir() / data["sensors"])  # an absolute path stays
+    if isinstance(data.get("mazes"), list):
+        data["mazes"] = [
+            str(Path(m).resolve()) if isinstance(m, str) and is_maze_file(m) else m
+            for m in data["mazes"]
+        ]
     data["episode_time"] = min(float(data.get("episode_time", 120.0)), SMALL_EPISODE_TIME)
     training = data.get("training")
     if isinstance(training, dict):

@@ -197,7 +197,7 @@ def _plan(run: ArbitratorRun) -> _Plan:
     neat_file = Path(run.neat_config) if run.neat_config else settings_file.neat_path()
     task_source = str(run.task or settings_file.task_path())
     task_settings = MazeTaskSettings.load(run.task or settings_file.task_path())
-    _check_mazes(task_settings, run.seed, robot, task_source)
+    task_settings = _check_mazes(task_settings, run.seed, robot, task_source)
     # The NEAT settings, the task's sensor layout and a network to start from, before any
     # work.
     layout = SensorLayout.load(config_dir() / task_settings.sensors)
@@ -242,21 +242,25 @@ def _plan(run: ArbitratorRun) -> _Plan:
     return _Plan(settings, repertoire, task_settings, initial_network, every, outputs)
 
 
-def _check_mazes(task_settings, seed: int, robot: str, source: str) -> None:
-    """Refuse held-out mazes and seeds, and a start the robot does not fit (before work).
+def _check_mazes(task_settings, seed: int, robot: str, source: str):
+    """The task settings with its mazes fitted to the robot; refuse held-out mazes and seeds.
 
-    Held out: docs/design.md section 22. Every nominal start must clear the robot's
-    footprint (replay and the bridge use it).
+    A maze the robot does not fit is scaled up to fit it (one warning line) and the scale
+    recorded with the task (docs/design.md section 21); a maze no scale fits is refused
+    before any work. Held out: docs/design.md section 22.
     """
+    from evorbc_ros.config import ConfigError
+    from offline_evolution.maze_task.base import fit_task_mazes
     from offline_evolution.maze_task.training import check_training
-    from sim_bridge.maze import load_named_maze
 
-    task_mazes = [load_named_maze(n) for n in task_settings.mazes]
+    try:
+        task_settings, task_mazes = fit_task_mazes(
+            task_settings, lookup(robot).footprint_radius, robot
+        )
+    except ConfigError as e:
+        raise UserError(f"{source}: {e}") from None
     check_training(task_mazes, task_settings.training, seed, source)
-    for maze in task_mazes:
-        misfit = maze.start_misfit(lookup(robot).footprint_radius, robot)
-        if misfit:
-            raise UserError(f"{source}: mazes: {misfit}")
+    return task_settings
 
 
 def _check_memory(run, settings_file, task_settings, neat_config, settings, source) -> None:

@@ -116,6 +116,8 @@ def _evaluate(run: EvaluateRun, report: Reporters) -> EvaluateOutcome:
         "robot": arb.robot,
         "repertoire": rep_path,
         "mazes": [m.name for m in task.mazes],
+        # Each maze's factor when one was scaled up to fit the robot (docs/design.md s. 21).
+        **({"maze_scale": list(task.settings.maze_scale)} if task.settings.maze_scale else {}),
         "generated": (
             {"count": run.generated, "seed": run.generated_seed} if run.generated else None
         ),

@@ -282,9 +282,14 @@ def maze_names() -> list[str]:
     return sorted(p.stem for p in maze_dir().glob("*.yaml"))
 
 
+def is_maze_file(name_or_path: str) -> bool:
+    """True if ``name_or_path`` names a maze file (a path), False if a shipped maze's name."""
+    return name_or_path.endswith((".yaml", ".yml")) or os.sep in name_or_path
+
+
 def load_named_maze(name_or_path: str) -> Maze:
     """A shipped maze by name, or any maze file by path."""
-    if name_or_path.endswith((".yaml", ".yml")) or os.sep in name_or_path:
+    if is_maze_file(name_or_path):
         return load_maze(name_or_path)
     # A name is looked up among the shipped ones, never joined into a path: a 300-letter
     # name would otherwise fail in the file system (ENAMETOOLONG), not as an unknown maze.

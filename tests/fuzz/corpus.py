@@ -69,7 +69,7 @@ SHORT_TASK = {
     "mazes": ["obstacle"],
     "episode_time": 1.0,
     "samples_per_maze": 1,
-    "sensors": "sensors/4ws-p8m.yaml",  # the shipped 4ws-5 controller's
+    "sensors": str(config_dir() / "sensors" / "4ws-p8m.yaml"),  # the shipped 4ws-5 controller's
 }
 #: A tiny MAP-Elites run, as tests/test_errors_checkpoints.py makes (80 evaluations).
 TINY_REPERTOIRE = ["--initial-batch", "20", "--batch-size", "10", "--iterations", "6"]

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from evorbc_ros.config import config_dir
 from fuzz.corpus import ARBITRATOR, COMMANDS, SHORT_TASK, Case, base_text, case
 
 MIB = 1 << 20
@@ -88,7 +89,7 @@ def yaml_cases() -> Iterator[Case]:
     yield case(
         "named/task/hexapod-sensors-in-4ws-task",
         "task",
-        {"f.yaml": _yaml({**SHORT_TASK, "sensors": "sensors/hexapod.yaml"})},
+        {"f.yaml": _yaml({**SHORT_TASK, "sensors": str(config_dir() / "sensors/hexapod.yaml")})},
     )
     yield case(
         "named/task/episode-time-1e300",
