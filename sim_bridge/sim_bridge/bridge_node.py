@@ -263,6 +263,24 @@ class SimBridgeNode(Node):
         out = [t for t in self.wait_subscribers if self.count_subscribers(t) == 0]
         return out + [t for t in self.wait_publishers if self.count_publishers(t) == 0]
 
+    def endpoints(self) -> frozenset:
+        """The graph's endpoints the bridge waits on: ``(topic, endpoint GID)`` pairs.
+
+        A restarted node comes back with new GIDs; a node that only dropped out of DDS
+        discovery for a while (its lease missed under load) comes back with the same ones.
+        """
+        subs = (
+            (t, bytes(i.endpoint_gid))
+            for t in self.wait_subscribers
+            for i in self.get_subscriptions_info_by_topic(self.resolve_topic_name(t))
+        )
+        pubs = (
+            (t, bytes(i.endpoint_gid))
+            for t in self.wait_publishers
+            for i in self.get_publishers_info_by_topic(self.resolve_topic_name(t))
+        )
+        return frozenset((*subs, *pubs))
+
     def other_graph(self) -> str:
         """Which topic has a second publisher (another graph in this domain); "" if none.
 
@@ -334,29 +352,37 @@ class SimBridgeNode(Node):
         A slow node is simply waited for: sending the state twice would make the nodes
         that already answered answer twice, and the extra commands would be taken for the
         next cycle's. The state is sent again when a node has left the graph and come
-        back (a restart), or, as a last resort, after ``lockstep_timeout`` s.
+        back as a new one (a restart: new endpoints), or, as a last resort, after
+        ``lockstep_timeout`` s. A node that drops out of discovery and comes back with
+        its old endpoints (a DDS lease missed on a loaded machine) lost no message: the
+        connections are reliable, so nothing is sent again (docs/design.md section 9).
         """
         sent = checked = time.monotonic()
         node_left = False
+        known = self.endpoints()
         while not all(self.fresh.values()) and running():
             executor.spin_once(timeout_sec=0.01)
             now = time.monotonic()
+            rejoined = False
             if now - checked > 0.1:
                 checked = now
                 gone = self.missing()
                 if gone and not node_left:
                     self.get_logger().warning(f"lost {', '.join(gone)}; waiting for it")
                 node_left = node_left or bool(gone)
-                rejoined = node_left and not gone
-            else:
-                rejoined = False
+                if node_left and not gone:
+                    node_left = False
+                    back = self.endpoints()
+                    rejoined = bool(back - known)
+                    known = back
+                    if not rejoined:
+                        self.get_logger().info("it is back with the same endpoints; waiting")
             if rejoined or now - sent > self.lockstep_timeout:
                 if rejoined:
                     self.spin_for(executor, 0.3)  # let the new node's connections settle
                 self.get_logger().info(f"sending the state again for t = {self.world.time:.1f} s")
                 self.publish_state()
                 sent = time.monotonic()
-                node_left = False
 
     def run_lockstep(self) -> None:
         """The lockstep loop: state out, both commands in, step."""
