@@ -85,7 +85,7 @@ TASK = """\
 mazes: [gaps]
 episode_time: 15.0
 samples_per_maze: 1
-sensors: sensors/4ws.yaml   # evorbc's (relative to its config/)
+sensors: sensors.yaml       # beside this file (a copy of evorbc's 4WS layout)
 """
 
 
@@ -99,6 +99,7 @@ def write_package(root: Path, module: str = MODULE) -> Path:
     (package / "repertoire.yaml").write_text(REPERTOIRE)
     (package / "arbitrator.yaml").write_text(ARBITRATOR)
     (package / "task.yaml").write_text(TASK)
+    (package / "sensors.yaml").write_text((config_dir() / "sensors" / "4ws.yaml").read_text())
     neat = (config_dir() / "neat" / "4ws.ini").read_text()
     small = neat.replace("pop_size              = 150", "pop_size              = 16")
     assert small != neat
