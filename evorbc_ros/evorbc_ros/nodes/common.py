@@ -29,9 +29,13 @@ from rclpy.qos import (
 )
 from std_msgs.msg import Float64MultiArray, MultiArrayDimension
 
-#: Our own streams: reliable, keep the last 10 (no loss in lockstep on one machine).
+#: Our own streams: reliable, with a deep history. A reliable writer keeps only its last
+#: ``depth`` samples for a reader that has not acknowledged them, and a lockstep graph runs
+#: hundreds of cycles a second: with 10, a recorder that stalled for a moment on a loaded
+#: machine (a disk flush, a starved core) lost a state's /scan and /odom (one cycle in 819).
+#: 1000 is the recorder's own depth (sim_bridge/recorder.py): some kB per topic, no loss.
 RELIABLE = QoSProfile(
-    depth=10, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST
+    depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST
 )
 #: Diagnostics that tools record: a deep history, so a listener that falls behind for a
 #: moment (a plotting tool, a test) does not lose samples.
