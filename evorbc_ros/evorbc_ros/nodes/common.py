@@ -33,7 +33,7 @@ from std_msgs.msg import Float64MultiArray, MultiArrayDimension
 #: ``depth`` samples for a reader that has not acknowledged them, and a lockstep graph runs
 #: hundreds of cycles a second: with 10, a recorder that stalled for a moment on a loaded
 #: machine (a disk flush, a starved core) lost a state's /scan and /odom (one cycle in 819).
-#: 1000 is the recorder's own depth (sim_bridge/recorder.py): some kB per topic, no loss.
+#: 1000 is the bag recorder's own depth: some kB per topic, no loss.
 RELIABLE = QoSProfile(
     depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST
 )
