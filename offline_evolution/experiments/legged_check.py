@@ -169,117 +169,19 @@ def summarise(
     """
     paper = PAPERS.get(robot, NOT_REPORTED)
     extra = lookup(robot).equal_budget_generations if standard_extra is None else standard_extra
-    rep = Repertoire.load(repertoire)
-    s = repertoire_stats(rep)
+    evo = [_evolution(out / f"evorbc-seed{k}.json") for k in seeds]
+    evo = [e for e in evo if e is not None]
+    std = [_evolution(out / f"standard-seed{k}.json") for k in standard_seeds]
+    std = [e for e in std if e is not None]
     lines = [
         "| figure | here | paper |",
         "|---|---|---|",
-        f"| repertoire size | {s['count']} primitives ({rep.algorithm.get('evaluations', 0):,} "
-        f"evaluations, {rep.algorithm.get('variation', 'paper')} operator) | {paper['count']} |",
-        f"| repertoire quality | {s['mean_quality']:.2f} ± {s['sd_quality']:.2f} | "
-        f"{paper['quality']} |",
-        f"| left/right symmetry (off-axis cells with a filled mirror cell) | "
-        f"{100 * s['mirrored']:.0f} %, left/right {s['left']}/{s['right']} | "
-        "asymmetric (Fig. 16) |",
+        *_repertoire_rows(Repertoire.load(repertoire), paper),
+        *(_evorbc_rows(evo, out, repertoire, paper) if evo else []),
+        *(_standard_rows(std, out, standard_seeds, extra, paper) if std else []),
+        *_running_rows(out, seeds, standard_seeds, extra, paper),
+        *_size_rows(out, seeds, standard_seeds, paper),
     ]
-    evo = [_evolution(out / f"evorbc-seed{k}.json") for k in seeds]
-    evo = [e for e in evo if e is not None]
-    if evo:
-        best = np.array([e["best_fitness"] for e in evo])
-        reached = sum(e["best_reached"] >= 1 for e in evo)
-        firsts = [
-            # 1-based, as the CLI's progress lines count generations
-            next((h["generation"] + 1 for h in e["history"] if h["best_reached"] >= 1), None)
-            for e in evo
-        ]
-        first_text = ", ".join("never" if f is None else str(f) for f in firsts)
-        sd = f" ± {best.std(ddof=1):.2f}" if len(best) > 1 else ""
-        lines.append(
-            f"| EvoRBC best fitness, {len(evo)} run(s) of {evo[0]['generations']} generations "
-            f"| {best.mean():.2f}{sd}; goal reached in {reached} of {len(evo)}; first reached "
-            f"at generation {first_text} | {paper['evorbc']} |"
-        )
-        nominal = [replay_nominal(out / f"evorbc-seed{e['seed']}.json", repertoire) for e in evo]
-        # The paper reports training fitness only; how the written controllers do over
-        # many starts, and from the nominal start where the demo puts the robot, is what a
-        # user gets, so it goes next to it.
-        posts = "; ".join(
-            f"seed {e['seed']} (rule {e['post_evaluation'].get('rule', 'mean')}): "
-            f"{e['post_evaluation']['fitness']:.2f}, reached "
-            f"{100 * e['post_evaluation']['reached']:.0f} % of "
-            f"{_post_episodes(e['post_evaluation'])}, "
-            f"{'reaches' if w['reached'] else 'misses'} from the nominal start"
-            for e, w in zip(evo, nominal, strict=True)
-        )
-        lines.append(
-            "| selected EvoRBC controllers over the nominal start and random starts "
-            f"(mean fitness, goal reached) | {posts} | not reported |"
-        )
-        switches = [w["switches_per_cycle"] for w in nominal]
-        rate = np.mean(switches)
-        lines.append(
-            f"| primitive switches of the selected arbitrators (nominal start) | "
-            f"{rate:.2f} per cycle, about every {1 / rate:.1f} cycles | {paper['switch']} |"
-            if rate > 0
-            else "| primitive switches | never switched | " + paper["switch"] + " |"
-        )
-    std = [_evolution(out / f"standard-seed{k}.json") for k in standard_seeds]
-    std = [e for e in std if e is not None]
-    if std:
-        best = np.array([e["best_fitness"] for e in std])
-        walks = [
-            replay_nominal(out / f"standard-seed{k}.json", None)
-            for k in standard_seeds
-            if (out / f"standard-seed{k}.json").exists()
-        ]
-        how_far = ", ".join(
-            "reached the goal" if w["reached"] else f"{100 * w['progress']:.0f} % of the way"
-            for w in walks
-        )
-        base = std[0]["generations"] - extra
-        at_base = (
-            # what standard NEAT had after as many generations as EvoRBC ran
-            f" ({np.mean([e['history'][base - 1]['best_so_far'] for e in std]):.2f} at "
-            f"generation {base}, EvoRBC's budget)"
-            if 0 < base <= min(len(e["history"]) for e in std)
-            else ""
-        )
-        lines.append(
-            f"| standard NEAT, {len(std)} run(s) of {std[0]['generations']} generations | "
-            f"best fitness {best.mean():.2f}{at_base}, goal reached in "
-            f"{sum(e['best_reached'] >= 1 for e in std)} of {len(std)} in training; the "
-            f"selected controller from the nominal start: {how_far} along the maze | "
-            f"{paper['standard']} |"
-        )
-    running = [(k, _progress(out / f"evorbc-seed{k}.json", 0)) for k in seeds]
-    running = [(k, p) for k, p in running if p is not None]
-    if running:
-        parts = "; ".join(f"seed {k}: {p}" for k, p in running)
-        lines.append(f"| EvoRBC still running (its checkpoint) | {parts} | |")
-    running = [(k, _progress(out / f"standard-seed{k}.json", extra)) for k in standard_seeds]
-    running = [(k, p) for k, p in running if p is not None]
-    if running:
-        # A 655-generation run outlasts a working session; what its checkpoint holds so
-        # far is worth reporting, as at EvoRBC's own budget of generations.
-        parts = "; ".join(f"seed {k}: {p}" for k, p in running)
-        lines.append(
-            f"| standard NEAT still running (its checkpoint) | {parts} | {paper['standard']} |"
-        )
-    sizes = {
-        kind: [network_size(out / f"{kind.name}-seed{k}.json") for k in ks]
-        for kind, ks in ((EVORBC, seeds), (STANDARD, standard_seeds))
-    }
-    sizes = {kind: [s for s in v if s is not None] for kind, v in sizes.items()}
-    if any(sizes.values()):
-        parts = [
-            f"{kind.label} {np.mean(sizes[kind]):.1f} ({len(sizes[kind])} run(s))"
-            for kind in (EVORBC, STANDARD)
-            if sizes[kind]
-        ]
-        lines.append(
-            "| network size of the written controllers (output and hidden neurons plus "
-            f"enabled synapses) | {', '.join(parts)} | {paper['size']} |"
-        )
     if evo or std:
         from offline_evolution.plots.fitness import plot_fitness_comparison
 
@@ -296,6 +198,135 @@ def summarise(
     text = "\n".join(lines) + "\n"
     atomic_write_text(out / f"{robot}-check.md", text)
     return text
+
+
+def _repertoire_rows(rep: Repertoire, paper: dict) -> list[str]:
+    """The repertoire's size, quality and left/right symmetry."""
+    s = repertoire_stats(rep)
+    return [
+        f"| repertoire size | {s['count']} primitives ({rep.algorithm.get('evaluations', 0):,} "
+        f"evaluations, {rep.algorithm.get('variation', 'paper')} operator) | {paper['count']} |",
+        f"| repertoire quality | {s['mean_quality']:.2f} ± {s['sd_quality']:.2f} | "
+        f"{paper['quality']} |",
+        f"| left/right symmetry (off-axis cells with a filled mirror cell) | "
+        f"{100 * s['mirrored']:.0f} %, left/right {s['left']}/{s['right']} | "
+        "asymmetric (Fig. 16) |",
+    ]
+
+
+def _evorbc_rows(evo: list[dict], out: Path, repertoire: Path, paper: dict) -> list[str]:
+    """EvoRBC's training fitness, its written controllers' results and their switching."""
+    best = np.array([e["best_fitness"] for e in evo])
+    reached = sum(e["best_reached"] >= 1 for e in evo)
+    firsts = [
+        # 1-based, as the CLI's progress lines count generations
+        next((h["generation"] + 1 for h in e["history"] if h["best_reached"] >= 1), None)
+        for e in evo
+    ]
+    first_text = ", ".join("never" if f is None else str(f) for f in firsts)
+    sd = f" ± {best.std(ddof=1):.2f}" if len(best) > 1 else ""
+    lines = [
+        f"| EvoRBC best fitness, {len(evo)} run(s) of {evo[0]['generations']} generations "
+        f"| {best.mean():.2f}{sd}; goal reached in {reached} of {len(evo)}; first reached "
+        f"at generation {first_text} | {paper['evorbc']} |"
+    ]
+    nominal = [replay_nominal(out / f"evorbc-seed{e['seed']}.json", repertoire) for e in evo]
+    # The paper reports training fitness only; how the written controllers do over
+    # many starts, and from the nominal start where the demo puts the robot, is what a
+    # user gets, so it goes next to it.
+    posts = "; ".join(
+        f"seed {e['seed']} (rule {e['post_evaluation'].get('rule', 'mean')}): "
+        f"{e['post_evaluation']['fitness']:.2f}, reached "
+        f"{100 * e['post_evaluation']['reached']:.0f} % of "
+        f"{_post_episodes(e['post_evaluation'])}, "
+        f"{'reaches' if w['reached'] else 'misses'} from the nominal start"
+        for e, w in zip(evo, nominal, strict=True)
+    )
+    lines.append(
+        "| selected EvoRBC controllers over the nominal start and random starts "
+        f"(mean fitness, goal reached) | {posts} | not reported |"
+    )
+    rate = np.mean([w["switches_per_cycle"] for w in nominal])
+    lines.append(
+        f"| primitive switches of the selected arbitrators (nominal start) | "
+        f"{rate:.2f} per cycle, about every {1 / rate:.1f} cycles | {paper['switch']} |"
+        if rate > 0
+        else "| primitive switches | never switched | " + paper["switch"] + " |"
+    )
+    return lines
+
+
+def _standard_rows(
+    std: list[dict], out: Path, standard_seeds: list[int], extra: int, paper: dict
+) -> list[str]:
+    """Standard NEAT's training fitness, also at EvoRBC's budget, and how far it walks."""
+    best = np.array([e["best_fitness"] for e in std])
+    walks = [
+        replay_nominal(out / f"standard-seed{k}.json", None)
+        for k in standard_seeds
+        if (out / f"standard-seed{k}.json").exists()
+    ]
+    how_far = ", ".join(
+        "reached the goal" if w["reached"] else f"{100 * w['progress']:.0f} % of the way"
+        for w in walks
+    )
+    base = std[0]["generations"] - extra
+    at_base = (
+        # what standard NEAT had after as many generations as EvoRBC ran
+        f" ({np.mean([e['history'][base - 1]['best_so_far'] for e in std]):.2f} at "
+        f"generation {base}, EvoRBC's budget)"
+        if 0 < base <= min(len(e["history"]) for e in std)
+        else ""
+    )
+    return [
+        f"| standard NEAT, {len(std)} run(s) of {std[0]['generations']} generations | "
+        f"best fitness {best.mean():.2f}{at_base}, goal reached in "
+        f"{sum(e['best_reached'] >= 1 for e in std)} of {len(std)} in training; the "
+        f"selected controller from the nominal start: {how_far} along the maze | "
+        f"{paper['standard']} |"
+    ]
+
+
+def _running_rows(
+    out: Path, seeds: list[int], standard_seeds: list[int], extra: int, paper: dict
+) -> list[str]:
+    """What the checkpoints of runs still going hold so far."""
+    lines = []
+    running = [(k, _progress(out / f"evorbc-seed{k}.json", 0)) for k in seeds]
+    running = [(k, p) for k, p in running if p is not None]
+    if running:
+        parts = "; ".join(f"seed {k}: {p}" for k, p in running)
+        lines.append(f"| EvoRBC still running (its checkpoint) | {parts} | |")
+    running = [(k, _progress(out / f"standard-seed{k}.json", extra)) for k in standard_seeds]
+    running = [(k, p) for k, p in running if p is not None]
+    if running:
+        # A 655-generation run outlasts a working session; what its checkpoint holds so
+        # far is worth reporting, as at EvoRBC's own budget of generations.
+        parts = "; ".join(f"seed {k}: {p}" for k, p in running)
+        lines.append(
+            f"| standard NEAT still running (its checkpoint) | {parts} | {paper['standard']} |"
+        )
+    return lines
+
+
+def _size_rows(out: Path, seeds: list[int], standard_seeds: list[int], paper: dict) -> list[str]:
+    """The written controllers' mean network size, per kind."""
+    sizes = {
+        kind: [network_size(out / f"{kind.name}-seed{k}.json") for k in ks]
+        for kind, ks in ((EVORBC, seeds), (STANDARD, standard_seeds))
+    }
+    sizes = {kind: [s for s in v if s is not None] for kind, v in sizes.items()}
+    if not any(sizes.values()):
+        return []
+    parts = [
+        f"{kind.label} {np.mean(sizes[kind]):.1f} ({len(sizes[kind])} run(s))"
+        for kind in (EVORBC, STANDARD)
+        if sizes[kind]
+    ]
+    return [
+        "| network size of the written controllers (output and hidden neurons plus "
+        f"enabled synapses) | {', '.join(parts)} | {paper['size']} |"
+    ]
 
 
 def network_size(path: Path) -> int | None:

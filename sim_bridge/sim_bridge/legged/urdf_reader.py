@@ -366,61 +366,83 @@ def _within(q: float, limits: tuple[float | None, float | None]) -> bool:
     return (low is None or q >= low - 1e-9) and (high is None or q <= high + 1e-9)
 
 
-def _stand(model: UrdfModel, kin: _Kinematics, turn: np.ndarray, leg: Leg, stance: float) -> None:
-    """The leg's standing pose and the thigh/knee coupling keeping its foot under its hip."""
-    names = dict(zip(leg.roles, leg.joints, strict=True))
-    limits = dict(zip(leg.roles, leg.limits, strict=True))
-    thigh, knee = names["thigh"], names["knee"]
-    if "abduction" in names:
-        low, high = limits["abduction"]
-        leg.abduction = 0.0 if _within(0.0, limits["abduction"]) else 0.5 * (low + high)
-        kin.set({names["abduction"]: leg.abduction})
-        if leg.abduction:
-            leg.notes.append("abduction: 0 is outside its limits; held at their middle")
+class _LegPlane:
+    """One leg's thigh and knee in the robot frame (turned Z-up), the other joints held."""
 
-    def foot_at(t: float, k: float) -> np.ndarray:
-        kin.set({thigh: t, knee: k})
-        return turn @ kin.link_frame(leg.foot)[0]
+    def __init__(self, kin: _Kinematics, turn: np.ndarray, leg: Leg, thigh: str, knee: str):
+        self.kin, self.turn, self.leg, self.thigh, self.knee = kin, turn, leg, thigh, knee
+        kin.set({thigh: 0.0, knee: 0.0})
+        self.hip = turn @ kin.joint_position(thigh)  # m, robot frame
+        self.knee_point = turn @ kin.joint_position(knee)
+        self.foot0 = self.foot_at(0.0, 0.0)
 
-    kin.set({thigh: 0.0, knee: 0.0})
-    hip = turn @ kin.joint_position(thigh)
-    knee_point = turn @ kin.joint_position(knee)
-    foot0 = foot_at(0.0, 0.0)
-    leg.segments = (
-        float(np.hypot(*(knee_point - hip)[[0, 2]])),
-        float(np.hypot(*(foot0 - knee_point)[[0, 2]])),
-    )
+    def foot_at(self, t: float, k: float) -> np.ndarray:
+        """The foot's position (m, robot frame) at thigh ``t`` and knee ``k`` (rad)."""
+        self.kin.set({self.thigh: t, self.knee: k})
+        return self.turn @ self.kin.link_frame(self.leg.foot)[0]
 
-    def under(k: float) -> float | None:
+    def under(self, k: float) -> float | None:
         """The thigh angle (rad) putting the foot straight below the hip, knee behind."""
+        hip = self.hip
         grid = np.linspace(-math.pi, math.pi, 73)  # 5 deg
-        values = [foot_at(t, k)[0] - hip[0] for t in grid]
+        values = [self.foot_at(t, k)[0] - hip[0] for t in grid]
         best = None
         for a, b, fa, fb in zip(grid[:-1], grid[1:], values[:-1], values[1:], strict=True):
             if fa == 0.0 or fa * fb < 0.0:
                 for _ in range(40):  # bisection to below 1e-12 rad
                     mid = 0.5 * (a + b)
-                    fm = foot_at(mid, k)[0] - hip[0]
+                    fm = self.foot_at(mid, k)[0] - hip[0]
                     a, b, fa = (a, mid, fa) if fa * fm <= 0.0 else (mid, b, fm)
                 t = 0.5 * (a + b)
-                below = foot_at(t, k)[2] < hip[2]
-                kin.set({thigh: t, knee: k})
-                behind = (turn @ kin.joint_position(knee))[0] < hip[0] - 1e-6
+                below = self.foot_at(t, k)[2] < hip[2]
+                self.kin.set({self.thigh: t, self.knee: k})
+                behind = (self.turn @ self.kin.joint_position(self.knee))[0] < hip[0] - 1e-6
                 if below and behind and (best is None or abs(t) < abs(best)):
                     best = t
         return best
 
-    def height(k: float) -> float:
-        t = under(k)
-        return -math.inf if t is None else float(hip[2] - foot_at(t, k)[2])
+    def height(self, k: float) -> float:
+        """m: the hip's height over the foot kept under it at knee ``k``; -inf if none."""
+        t = self.under(k)
+        return -math.inf if t is None else float(self.hip[2] - self.foot_at(t, k)[2])
 
-    straight = sum(leg.segments)
-    target = stance * straight
-    low, high = limits["knee"]
+
+def _stand(model: UrdfModel, kin: _Kinematics, turn: np.ndarray, leg: Leg, stance: float) -> None:
+    """The leg's standing pose and the thigh/knee coupling keeping its foot under its hip."""
+    names = dict(zip(leg.roles, leg.joints, strict=True))
+    limits = dict(zip(leg.roles, leg.limits, strict=True))
+    if "abduction" in names:
+        _hold_abduction(kin, leg, names["abduction"], limits["abduction"])
+    plane = _LegPlane(kin, turn, leg, names["thigh"], names["knee"])
+    leg.segments = (
+        float(np.hypot(*(plane.knee_point - plane.hip)[[0, 2]])),
+        float(np.hypot(*(plane.foot0 - plane.knee_point)[[0, 2]])),
+    )
+    k0 = _standing_knee(model, plane, limits["knee"], stance * sum(leg.segments))
+    c0, c1, k_low, k_high = _knee_range_and_coupling(model, plane, limits["knee"], k0)
+    leg.thigh_stand = float(c0 + c1 * k0)
+    leg.foot_stand = plane.foot_at(leg.thigh_stand, k0)
+    _swing_room(leg, limits["thigh"], [c0 + c1 * k for k in (k_low, k_high)])
+    kin.set({names["thigh"]: 0.0, names["knee"]: 0.0})
+
+
+def _hold_abduction(kin: _Kinematics, leg: Leg, joint: str, limits) -> None:
+    """Hold the abduction at 0 rad, or at its limits' middle when 0 is outside them."""
+    low, high = limits
+    leg.abduction = 0.0 if _within(0.0, limits) else 0.5 * (low + high)
+    kin.set({joint: leg.abduction})
+    if leg.abduction:
+        leg.notes.append("abduction: 0 is outside its limits; held at their middle")
+
+
+def _standing_knee(model: UrdfModel, plane: _LegPlane, limits, target: float) -> float:
+    """The knee angle (rad) at which the foot under the hip is ``target`` m below it."""
+    leg = plane.leg
+    low, high = limits
     knees = np.linspace(
         -math.pi + 0.01 if low is None else low, math.pi - 0.01 if high is None else high, 181
     )
-    heights = np.array([height(k) for k in knees])
+    heights = np.array([plane.height(k) for k in knees])
     crossing = [
         (a, b)
         for a, b, ha, hb in zip(knees[:-1], knees[1:], heights[:-1], heights[1:], strict=True)
@@ -433,19 +455,26 @@ def _stand(model: UrdfModel, kin: _Kinematics, turn: np.ndarray, leg: Leg, stanc
                 f"{model.path}: leg {leg.name}: no knee angle puts its foot below its hip "
                 "with the knee behind; write its settings by hand (docs/legged.md)"
             )
-        k0 = float(
-            knees[int(np.argmin(np.where(np.isfinite(heights), np.abs(heights - target), np.inf)))]
-        )
         leg.notes.append(f"knee: the stance height {target:.3f} m is out of reach; nearest kept")
-    else:
-        # The bend nearest straight that reaches the height (fold the knee least).
-        a, b = min(crossing, key=lambda ab: abs(ab[0] + ab[1]))
-        ha = height(a) - target
-        for _ in range(40):
-            mid = 0.5 * (a + b)
-            hm = height(mid) - target
-            a, b, ha = (a, mid, ha) if ha * hm <= 0.0 else (mid, b, hm)
-        k0 = 0.5 * (a + b)
+        gap = np.where(np.isfinite(heights), np.abs(heights - target), np.inf)
+        return float(knees[int(np.argmin(gap))])
+    # The bend nearest straight that reaches the height (fold the knee least).
+    a, b = min(crossing, key=lambda ab: abs(ab[0] + ab[1]))
+    ha = plane.height(a) - target
+    for _ in range(40):
+        mid = 0.5 * (a + b)
+        hm = plane.height(mid) - target
+        a, b, ha = (a, mid, ha) if ha * hm <= 0.0 else (mid, b, hm)
+    return 0.5 * (a + b)
+
+
+def _knee_range_and_coupling(model: UrdfModel, plane: _LegPlane, limits, k0: float):
+    """The knee's range about ``k0`` and the line thigh = c0 + c1 knee keeping the foot under.
+
+    Returns ``(c0, c1, k_low, k_high)``, rad; sets the leg's knee and coupling fields.
+    """
+    leg = plane.leg
+    low, high = limits
     leg.knee_stand = k0
     half = KNEE_HALF_RANGE
     k_low = max(k0 - half, low if low is not None else -math.inf)
@@ -454,7 +483,7 @@ def _stand(model: UrdfModel, kin: _Kinematics, turn: np.ndarray, leg: Leg, stanc
         leg.notes.append("knee: its range is cut by the URDF's limits")
     leg.knee_range = (k_low, k_high)
     samples = np.linspace(k_low, k_high, 31)
-    thighs = np.array([under(k) for k in samples], dtype=float)
+    thighs = np.array([plane.under(k) for k in samples], dtype=float)
     if np.isnan(thighs).any():
         raise UrdfError(
             f"{model.path}: leg {leg.name}: over the knee's standing range its foot cannot "
@@ -463,13 +492,17 @@ def _stand(model: UrdfModel, kin: _Kinematics, turn: np.ndarray, leg: Leg, stanc
     c1, c0 = np.polyfit(samples, thighs, 1)
     leg.coupling = (float(c0), float(c1))
     leg.coupling_error = float(np.max(np.abs(c0 + c1 * samples - thighs)))
-    leg.thigh_stand = float(c0 + c1 * k0)
-    leg.foot_stand = foot_at(leg.thigh_stand, k0)
-    # The swing adds to the thigh: keep thigh = swing + coupling within the thigh's limits.
-    t_low, t_high = limits["thigh"]
+    return c0, c1, k_low, k_high
+
+
+def _swing_room(leg: Leg, limits, thighs: list[float]) -> None:
+    """The swing's half range (rad): the swing adds to the thigh, whose limits it keeps.
+
+    ``thighs``: the coupled thigh angle (rad) at each end of the knee's range.
+    """
+    t_low, t_high = limits
     room = [SWING_HALF_RANGE]
-    for k in (k_low, k_high):
-        t = c0 + c1 * k
+    for t in thighs:
         if t_low is not None:
             room.append(t - t_low)
         if t_high is not None:
@@ -477,7 +510,6 @@ def _stand(model: UrdfModel, kin: _Kinematics, turn: np.ndarray, leg: Leg, stanc
     leg.swing_half = max(0.0, min(room))
     if leg.swing_half < SWING_HALF_RANGE:
         leg.notes.append("swing: its range is cut by the thigh's limits")
-    kin.set({thigh: 0.0, knee: 0.0})
 
 
 def _share_mirrors(legs: list[Leg]) -> None:

@@ -94,10 +94,22 @@ def settings_text(
             is not Z-up, else None.
 
     """
-    model, legs = derived.model, derived.legs
-    hz = frequency(legs)
-    torque = _limit(legs, model, "effort")
-    velocity = _limit(legs, model, "velocity")
+    hz = frequency(derived.legs)
+    lines = [
+        *_header(derived, name, turned_name),
+        *_legs(derived),
+        *_oscillators(derived.legs),
+        *_joints(derived.legs),
+        *_gait_and_servo(derived, hz),
+        *_physics(),
+        *_bounds(derived.legs, hz, measured),
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _header(derived: DerivedRobot, name: str, turned_name: str | None) -> list[str]:
+    """The file's opening comment, its name and its URDF."""
+    model = derived.model
     lines = [
         f"# {name}: a legged robot read from {model.path.name} by `evorbc-evolve robot-from-urdf`",
         '# (docs/legged.md, "From a URDF"), from the URDF alone: every value says how it was',
@@ -114,8 +126,14 @@ def settings_text(
         )
     else:
         lines.append(f"urdf: {_urdf_value(derived, None)}")
+    return lines
+
+
+def _legs(derived: DerivedRobot) -> list[str]:
+    """The base and foot links, and each leg as read (comments)."""
+    legs = derived.legs
     feet = ", ".join(leg.foot for leg in legs)
-    lines += [
+    lines = [
         "links:",
         f"  base: {derived.base}  # the URDF's root link",
         f"  feet: [{feet}]  # per leg, the leaf link below its last moving joint",
@@ -132,7 +150,12 @@ def settings_text(
             f"{leg.segments[1]:.3f} m; standing foot at {_xyz(leg.foot_stand)}",
         ]
         lines += [f"#     note: {note}" for note in leg.notes]
-    lines += [
+    return lines
+
+
+def _oscillators(legs: list[Leg]) -> list[str]:
+    """The evolved swing and knee of each leg, with their ranges in degrees."""
+    lines = [
         "# Evolved (eq. 10-11), per leg: the swing (the hip-to-foot line's angle from the",
         "# vertical, positive backwards) and the knee (its joint angle, sign turned so that",
         "# positive turns about +y). Swing +-25 deg and knee +-15 deg about standing are the",
@@ -153,7 +176,12 @@ def settings_text(
             f"{leg.mirror}_knee}}  # standing {_deg(source.knee_stand * s)} +- "
             f"{_deg(KNEE_HALF_RANGE, 0)}",
         ]
-    lines += [
+    return lines
+
+
+def _joints(legs: list[Leg]) -> list[str]:
+    """Every actuated joint's drive, in command order."""
+    lines = [
         "# Every actuated joint in command order: constant + sum(coefficient x oscillator).",
         "# The thigh follows the swing and the knee so that the foot stays under the hip: the",
         "# thigh angle doing so, found by forward kinematics over the knee's range, fitted by a",
@@ -164,29 +192,43 @@ def settings_text(
     for leg in legs:
         for joint, role in zip(leg.joints, leg.roles, strict=True):
             lines.append(f"  {joint}: {_drive(leg, role)}")
-    rate_steps = "control_period and settle_time are whole steps"
-    lines += [
+    return lines
+
+
+def _gait_and_servo(derived: DerivedRobot, hz: float) -> list[str]:
+    """The gait frequency (Hz) and the servo: gain (1/s), speed (rad/s) and torque (N m)."""
+    model, legs = derived.model, derived.legs
+    longest = max(sum(leg.segments) for leg in legs)  # m, thigh + shank
+    lines = [
         "gait:",
         f"  frequency_hz: {hz:g}  # the A1's {A1_FREQUENCY:g} Hz at equal Froude number: "
-        f"x sqrt({A1_LEG:g} m / {max(sum(leg.segments) for leg in legs):.3f} m leg)",
+        f"x sqrt({A1_LEG:g} m / {longest:.3f} m leg)",
         "servo:  # v = clip(gain x error, +-max_velocity), torque <= max_torque",
         f'  gain: {A1_GAIN:g}  # 1/s, the A1\'s (docs/a1.md, "Gait design")',
     ]
+    velocity = _limit(legs, model, "velocity")
     if velocity:
         lines.append(
             f"  max_velocity: {velocity:g}  # rad/s, the URDF's least thigh/knee <limit velocity>"
         )
     else:
         lines.append("  max_velocity: 21.0  # rad/s, the A1's: the URDF gives no <limit velocity>")
+    torque = _limit(legs, model, "effort")
     if torque:
         lines.append(f"  max_torque: {torque:g}  # N m, the URDF's least thigh/knee effort")
     else:
-        weight = derived.mass * 9.81 * max(sum(leg.segments) for leg in legs)
+        weight = derived.mass * 9.81 * longest  # N m: the whole weight at one leg's length
         lines.append(
             f"  max_torque: {math.ceil(weight):g}  # N m: the URDF gives no <limit effort>; the "
             "whole weight at one leg's length"
         )
-    lines += [
+    return lines
+
+
+def _physics() -> list[str]:
+    """The physics rate, solver, friction, tilts and control period: the A1's."""
+    rate_steps = "control_period and settle_time are whole steps"
+    return [
         "physics:",
         f'  rate_hz: {A1_RATE:g}  # the A1\'s (docs/a1.md, "Physics rate"); {rate_steps}',
         "  solver_iterations: 50",
@@ -198,6 +240,11 @@ def settings_text(
         "  fallen_deg: 90  # an episode ends: the robot fell over",
         "control_period: 0.1  # s",
     ]
+
+
+def _bounds(legs: list[Leg], hz: float, measured: Measured | None) -> list[str]:
+    """The footprint (m, when measured), the speed bound (m/s) and self-collision."""
+    lines = []
     if measured is not None:
         lines.append(
             f"footprint_radius: {math.ceil(100.0 * measured.reach_radius) / 100.0:.2f}  # m: every "
@@ -205,12 +252,12 @@ def settings_text(
             f"standing {measured.seconds:g} s it kept {measured.height:.3f} m and tilted "
             f"{measured.tilt:.1f} deg at most"
         )
-    lines += [
+    return [
+        *lines,
         f"speed_bound: {speed_bound(legs, hz):g}  # m/s: {SPEED_MARGIN:g} x the widest swing's "
         "sweep, 2 h tan(swing) x frequency",
         "self_collision: false  # the A1's",
     ]
-    return "\n".join(lines) + "\n"
 
 
 def _drive(leg: Leg, role: str) -> str:
