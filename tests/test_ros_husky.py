@@ -97,3 +97,24 @@ def test_the_graph_drives_the_scaled_maze_exactly_as_offline(tmp_path, controlle
     # Both started at the scaled maze's nominal start.
     x, y, _ = load_named_maze(MAZE).start_pose
     assert tuple(trajectory[0, :2]) == (x * FACTOR, y * FACTOR)
+
+
+def test_the_bridge_fits_the_maze_or_applies_the_factor_given(husky_path):
+    from evorbc_ros.nodes.common import StartupError
+    from sim_bridge.bridge_node import robot_maze
+
+    maze, factor, warning = robot_maze(MAZE, 0.0, 0.6, "husky")
+    assert factor == FACTOR and maze.target_radius == load_named_maze(MAZE).target_radius * FACTOR
+    assert warning == (
+        "maze a1 scaled x1.211 to fit robot husky: its narrowest gap on the way is 1.190 m "
+        "and the robot needs 1.440 m (1.2 x its 0.600 m footprint radius each side)"
+    )
+    # A recorded factor is applied as it is, without the line, as offline.
+    maze, factor, warning = robot_maze(MAZE, 2.0, 0.6, "husky")
+    assert factor == 2.0 and warning is None and maze.start_pose[0] == 2.0 * -3.4
+    # A robot that fits gets the maze as its file has it.
+    assert robot_maze(MAZE, 0.0, 0.05, "4ws-5")[1:] == (1.0, None)
+    with pytest.raises(StartupError, match=r"^parameter maze_scale must be 0 \(fit the robot\) "):
+        robot_maze(MAZE, 0.5, 0.6, "husky")
+    with pytest.raises(StartupError, match=r"^parameter maze: unknown maze 'nosuch'"):
+        robot_maze("nosuch", 0.0, 0.6, "husky")
