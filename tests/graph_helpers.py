@@ -38,7 +38,10 @@ class GraphRun:
         arbitrator=None,
         repertoire="",
         robot="4ws-5",
+        bridge=None,
     ):
+        """``bridge``: more parameters of the bridge (e.g. the ``laser_range`` that
+        :func:`sim_bridge.graph.sim_graph` gives a large robot's controller)."""
         self.env = graph_env(domain)
         self.result = tmp_path / f"{maze}-{mode}.json"
         self.log = open(tmp_path / f"{maze}-{mode}.log", "w")  # noqa: SIM115
@@ -66,6 +69,7 @@ class GraphRun:
                 "mode": mode,
                 "result_file": str(self.result),
                 "episode_time": episode_time,
+                **(bridge or {}),
             },
         )
 

@@ -25,6 +25,7 @@ PACKAGES = {
 #: Python distributions -> their rosdep keys (ros/rosdistro rosdep/python.yaml).
 ROSDEP = {
     "numpy": "python3-numpy",
+    "scipy": "python3-scipy",
     "yaml": "python3-yaml",
     "matplotlib": "python3-matplotlib",
     "PIL": "python3-pil",

@@ -16,10 +16,10 @@ import pytest
 
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.settings_robots import PATH_VARIABLE
-from offline_evolution.mazes.fit import fit_scale
 from offline_evolution.mazes.generator import generate_maze, spec_for_robot
 from offline_evolution.mazes.paths import narrowest_gap, solve, stranded_starts
 from sim_bridge.maze import load_named_maze
+from sim_bridge.maze_fit import fit_scale
 
 HUSKY = Path(__file__).parent / "robots" / "husky"
 

@@ -187,26 +187,27 @@ def test_bridge_skips_malformed_trajectories_and_holds_the_last_targets():
 def test_evorbc_sim_refuses_a_start_inside_the_legs_reach_before_starting_the_graph(
     tmp_path, controller, capsys
 ):
-    from sim_bridge.bringup import main
+    from evorbc_ros.robots import registry
+    from sim_bridge.bringup import main, parse_args, prepare
 
     arb_path, rep_path, _, _ = controller
     old = tmp_path / "result.json"
     old.write_text('{"reached": true}')
     argv = ["--arbitrator", str(arb_path), "--repertoire", str(rep_path), "--quiet"]
     # The obstacle maze's nominal start is 0.09 m from a wall; the legs reach 0.31 m. No
-    # --start was given: the robot does not fit the maze.
-    assert main([*argv, "--maze", "obstacle", "--result", str(old), "--plot", ""]) == 2
+    # --start was given: the maze is scaled up to fit the robot, as offline runs do.
+    _, maze, _ = prepare(parse_args([*argv, "--maze", "obstacle"]))
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == [
-        "evorbc-sim: error: robot hexapod does not fit maze obstacle: at the maze's start "
-        "(-5.46, 0.65) m the nearest wall is 0.094 m away, and the robot needs 0.313 m; "
-        "its maze is hexapod"
-    ]
-    # A start the user gives is what is blamed.
-    assert main([*argv, "--maze", "obstacle", "--start=-5.46,0.65,0", "--plot", ""]) == 2
+    assert len(err) == 1 and err[0].startswith("evorbc: warning: maze obstacle scaled x")
+    assert maze.start_misfit(registry.lookup("hexapod").footprint_radius, "hexapod") is None
+    # A start the user gives, 0.1 m inside the top wall's outer surface, is what is blamed.
+    x, top = maze.start_pose[0], maze.bounds()[3] - 0.1
+    start = f"--start={x:.2f},{top:.2f},0"
+    assert main([*argv, "--maze", "obstacle", start, "--result", str(old), "--plot", ""]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("evorbc-sim: error: --start: (-5.46, 0.65) m is")
-    assert "m from a wall of maze obstacle" in err[0]
+    assert len(err) == 2 and err[0].startswith("evorbc: warning: maze obstacle scaled x")
+    assert err[1].startswith(f"evorbc-sim: error: --start: ({x:.2f}, {top:.2f}) m is")
+    assert "m from a wall of maze obstacle" in err[1]
     assert old.exists()  # refused before anything ran: nothing of the user's is touched
 
 

@@ -4,11 +4,13 @@ The launch file is run against stand-ins for ``launch`` and ``launch_ros``, so t
 where ROS 2's launch is not installed; the real one is tried in test_install_wheel and
 test_install_colcon where the ros2 CLI is installed."""
 
+import json
 import runpy
 import sys
 import types
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from evorbc_ros.config import ConfigError, config_dir
@@ -350,10 +352,35 @@ def test_a_robot_without_a_shipped_controller_says_how_to_make_one(capsys, no_gr
     ]
 
 
-def test_a_robot_that_does_not_fit_the_maze_is_not_blamed_on_start(capsys, no_graph):
-    code, err = run_sim(capsys, "--robot", "hexapod", "--maze", "zigzag")
+def test_a_maze_the_robot_does_not_fit_is_scaled_as_offline_and_not_blamed_on_start(
+    capsys, tmp_path, no_graph
+):
+    from evorbc_ros.robots import registry
+    from sim_bridge.maze import load_named_maze
+    from sim_bridge.maze_fit import fit_scale
+
+    radius = registry.lookup("hexapod").footprint_radius
+    factor = fit_scale(load_named_maze("zigzag"), radius)
+    assert factor > 1.0  # zigzag's start is too narrow for the hexapod's legs
+    # The bridge gets the maze offline runs would use: scaled by the same factor, with the
+    # same warning line, and the factor is passed on so that the bridge does not fit again.
+    args = bringup.parse_args(["--robot", "hexapod", "--maze", "zigzag"])
+    _, maze, _ = bringup.prepare(args)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(
+        f"evorbc: warning: maze zigzag scaled x{factor:g} to fit robot hexapod: "
+    )
+    assert args.maze_scale == factor and maze.start_misfit(radius, "hexapod") is None
+    np.testing.assert_array_equal(maze.walls, load_named_maze("zigzag").walls * factor)
+    bridge = sim_graph(robot="hexapod", maze="zigzag", maze_scale=factor).node("sim_bridge")
+    assert bridge.parameters["maze_scale"] == factor
+    # A factor the controller's task records is applied as it is, without the line: one
+    # too small to clear the robot's start is refused, and not blamed on --start.
+    arb = json.loads(Path(default_arbitrator("hexapod")).read_text())
+    arb["evolution"]["task"].update(mazes=["zigzag"], maze_scale=[1.0])
+    edited = tmp_path / "edited.json"
+    edited.write_text(json.dumps(arb))
+    code, err = run_sim(capsys, "--arbitrator", str(edited), "--maze", "zigzag")
     assert code == 2 and len(err) == 1
     assert err[0].startswith("evorbc-sim: error: robot hexapod does not fit maze zigzag: ")
     assert "--start" not in err[0] and err[0].endswith("its maze is hexapod")
-    code, err = run_sim(capsys, "--robot", "hexapod", "--maze", "zigzag", "--start", "random")
-    assert err[0].startswith("evorbc-sim: error: robot hexapod does not fit maze zigzag: ")

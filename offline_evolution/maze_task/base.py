@@ -183,7 +183,7 @@ def fit_task_mazes(
     """The task's mazes, each scaled up to fit the robot, and the settings recording it.
 
     A maze whose factor ``settings.maze_scale`` records is scaled by it; any other is
-    scaled by the smallest factor that fits (:func:`~offline_evolution.mazes.fit.fit_scale`,
+    scaled by the smallest factor that fits (:func:`~sim_bridge.maze_fit.fit_scale`,
     docs/design.md section 21), with one warning line on stderr naming the maze, the factor
     and why. The settings returned record every factor (``maze_scale``) when one is not 1,
     else they are ``settings`` unchanged.
@@ -194,7 +194,7 @@ def fit_task_mazes(
             post-selection and the ROS bridge start there).
     """
     from evorbc_ros.robots.adapters import report
-    from offline_evolution.mazes.fit import fitted_maze
+    from sim_bridge.maze_fit import fitted_maze
 
     recorded = settings.maze_scale or (None,) * len(settings.mazes)
     mazes, factors = [], []

@@ -125,7 +125,7 @@ def spec_for_robot(name: str) -> MazeSpec:
     """The generator's settings for a registered robot, from its registration.
 
     Sizes come from the robot's default maze, scaled up uniformly when the robot does not
-    fit it (:mod:`~offline_evolution.mazes.fit`: its start, or a route keeping 1.2 times the
+    fit it (:mod:`~sim_bridge.maze_fit`: its start, or a route keeping 1.2 times the
     footprint radius; one warning line on stderr), so corridors, gaps, openings, wall
     lengths, the start region and the target radius all grow with the footprint. A robot
     that fits its maze (every shipped robot) gets exactly the sizes of that maze. The
@@ -138,8 +138,7 @@ def spec_for_robot(name: str) -> MazeSpec:
     """
     from evorbc_ros.robots.adapters import report
     from evorbc_ros.robots.registry import lookup
-
-    from .fit import fitted_maze
+    from sim_bridge.maze_fit import fitted_maze
 
     robot = lookup(name)
     own = load_named_maze(robot.maze)

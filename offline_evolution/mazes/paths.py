@@ -23,12 +23,14 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from scipy.ndimage import binary_dilation, label
+from scipy.ndimage import binary_dilation
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from sim_bridge.geometry import box_distances
 from sim_bridge.maze import Maze
+
+# The pure clearance and gap searches live with the fitting, which the bridge uses too.
+from sim_bridge.maze_fit import clearance_grid, narrowest_gap
 
 ROBOT_RADIUS = 0.05  # m, collision footprint of the 4WS robot (docs/design.md section 2)
 MARGIN = 0.06  # m, clearance a path must keep from every wall surface
@@ -131,19 +133,6 @@ def distance_grid(field: Field) -> DistanceGrid:
         step, (jj, ii) = distance_transform_edt(~known, return_indices=True)
         values = values[jj, ii] + step * cell
     return DistanceGrid(float(field.xs[0]), float(field.ys[0]), cell, values.astype(np.float32))
-
-
-def clearance_grid(maze: Maze, cell: float = 0.01) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Cell centres ``xs (nx,)``, ``ys (ny,)`` and the clearance ``(ny, nx)`` in m."""
-    x0, y0, x1, y1 = maze.bounds()
-    xs = x0 + (np.arange(math.ceil((x1 - x0) / cell)) + 0.5) * cell
-    ys = y0 + (np.arange(math.ceil((y1 - y0) / cell)) + 0.5) * cell
-    gx, gy = np.meshgrid(xs, ys)
-    px, py = gx.ravel(), gy.ravel()
-    near = np.full(px.shape, np.inf)
-    for box in maze.boxes:
-        np.minimum(near, box_distances(px, py, box), out=near)
-    return xs, ys, near.reshape(gx.shape)
 
 
 def solve(maze: Maze, cell: float = 0.01, margin: float = MARGIN, snap: float = SNAP) -> Field:
@@ -280,37 +269,6 @@ def wall_followers(maze: Maze, keep: float = FOLLOW) -> dict[str, float]:
         hand = "left" if (direction == 1) == wall_on_left else "right"
         out[hand] = length
     return out
-
-
-def narrowest_gap(maze: Maze, cell: float = 0.01, resolution: float = 0.001, grid=None) -> float:
-    """Width (m, wall surface to wall surface) of the narrowest gap on the widest route.
-
-    Twice the largest clearance that still connects the start region to the target: the
-    robot cannot avoid a gap this narrow, and need not pass a narrower one. Cell centres
-    miss a gap's middle by up to half a cell each way, so this reads low by up to ``cell``.
-    ``grid``: the ``(xs, ys, clearance)`` to search, if not :func:`clearance_grid`'s.
-    """
-    xs, ys, clear = grid if grid is not None else clearance_grid(maze, cell)
-    gx, gy = np.meshgrid(xs, ys)
-    start = (
-        (maze.start_x[0] <= gx)
-        & (gx <= maze.start_x[1])
-        & (maze.start_y[0] <= gy)
-        & (gy <= maze.start_y[1])
-    )
-    goal = np.hypot(gx - maze.target[0], gy - maze.target[1]) <= maze.target_radius
-    structure = np.ones((3, 3), bool)  # 8-connectivity, as in :func:`solve`
-
-    def connected(level: float) -> bool:
-        labels, _ = label(clear >= level, structure)
-        ends = set(labels[start & (clear >= level)]) & set(labels[goal & (clear >= level)])
-        return bool(ends - {0})
-
-    lo, hi = 0.0, float(clear.max())
-    while hi - lo > resolution / 2:
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if connected(mid) else (lo, mid)
-    return 2.0 * lo
 
 
 def start_cells(maze: Maze, field: Field, robot_radius: float = ROBOT_RADIUS) -> np.ndarray:

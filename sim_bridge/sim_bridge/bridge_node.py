@@ -116,12 +116,12 @@ class SimBridgeNode(Node):
             # a graph shut down meanwhile (another node refused to start) would otherwise
             # interrupt the import with a KeyboardInterrupt traceback.
             from sim_bridge.bridge_robots import bridge_robot_class
-            from sim_bridge.maze import load_named_maze
 
-            try:
-                maze = load_named_maze(p["maze"])
-            except ConfigError as e:
-                raise StartupError(f"parameter maze: {e}") from None
+            maze, self.maze_scale, warning = robot_maze(
+                p["maze"], p["maze_scale"], spec.footprint_radius, robot
+            )
+            if warning:  # offline runs say the same in the same words
+                self.get_logger().warning(warning)
             kind = bridge_robot_class(robot)
             pose = self._start_pose(maze, p["start"], p["seed"], spec.footprint_radius, robot)
             self.robot = kind(self, robot, maze, pose, episode_time, p["gui"])
@@ -146,7 +146,7 @@ class SimBridgeNode(Node):
         goal.point.x, goal.point.y = self.world.maze.target
         self.goal_pub.publish(goal)
         self.get_logger().info(
-            f"{robot} in maze {maze.name} ({self.mode}), start "
+            f"{robot} in maze {maze.name}{scaled(self.maze_scale)} ({self.mode}), start "
             f"({pose[0]:.3f}, {pose[1]:.3f}, {math.degrees(pose[2]):.1f} deg)"
         )
 
@@ -435,6 +435,7 @@ class SimBridgeNode(Node):
         s = self.world.status()
         result = {
             "maze": self.world.maze.name,
+            "maze_scale": self.maze_scale,
             "robot": self.robot.name,
             "reached": s.reached,
             "fell": s.fell,
@@ -456,6 +457,36 @@ class SimBridgeNode(Node):
         if self.context.ok():
             self.get_logger().info(f"{episode_verdict(result)}; fitness {s.fitness:.3f}")
         return result
+
+
+def robot_maze(name: str, scale: float, footprint_radius: float, robot: str):
+    """``(maze, factor, warning)``: the maze ``name`` scaled to fit the robot, as offline.
+
+    ``scale`` 0: the smallest factor by which the robot fits (1.0 if it fits as it is), with
+    the warning line offline runs print; else this factor (a controller's recorded one), as
+    it is and without a warning (:func:`sim_bridge.maze_fit.load_fitted_maze`, docs/design.md
+    section 21). ``footprint_radius`` in m.
+
+    Raises:
+        StartupError: the maze does not load, ``scale`` is in (0, 1), or no factor fits
+            (one line naming the parameter).
+    """
+    from sim_bridge.maze_fit import load_fitted_maze
+
+    if 0.0 < scale < 1.0:
+        raise StartupError(
+            f"parameter maze_scale must be 0 (fit the robot) or a factor of at least 1, "
+            f"got {scale:g}"
+        )
+    try:
+        return load_fitted_maze(name, footprint_radius, robot, scale or None)
+    except ConfigError as e:
+        raise StartupError(f"parameter maze: {e}") from None
+
+
+def scaled(factor: float) -> str:
+    """`` scaled xF`` for a maze scaled to fit the robot, "" for one as its file has it."""
+    return "" if factor == 1.0 else f" scaled x{factor:g}"
 
 
 def episode_verdict(result: dict) -> str:

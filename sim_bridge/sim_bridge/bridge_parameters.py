@@ -11,6 +11,15 @@ from evorbc_ros.node_parameters import COMMON, spec
 
 PARAMETERS = (
     spec("maze", "obstacle", "maze name (config/mazes) or maze YAML file"),
+    spec(
+        "maze_scale",
+        0.0,
+        "factor (>= 1) the maze is scaled up by about its origin; 0: the smallest that fits "
+        "the robot, as offline runs fit it (1 if it fits as it is); evorbc-sim and the launch "
+        "file give the one the controller's task recorded",
+        0.0,
+        100.0,
+    ),
     spec("robot", "4ws-5", "robot type (a registered robot)"),
     spec(
         "mode",

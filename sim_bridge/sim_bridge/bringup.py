@@ -32,12 +32,19 @@ from evorbc_ros.defaults import (
 from evorbc_ros.nodes.common import StartupError
 from evorbc_ros.repertoire import RepertoireError
 from evorbc_ros.robots import registry
+from evorbc_ros.robots.adapters import report
 from evorbc_ros.robots.registry import DEFAULT_ROBOT
 from sim_bridge.bridge_node import SimBridgeNode, episode_verdict
 from sim_bridge.cli_options import add_arbitrator, add_flag, add_repertoire, add_robot, add_seed
 from sim_bridge.cli_support import OneLineParser, check_output_file, integer_in, report_unexpected
-from sim_bridge.graph import NodeSpec, exit_ends_graph, shipped_arbitrator, sim_graph
-from sim_bridge.maze import Maze, load_named_maze, maze_names
+from sim_bridge.graph import (
+    NodeSpec,
+    exit_ends_graph,
+    recorded_maze_scale,
+    shipped_arbitrator,
+    sim_graph,
+)
+from sim_bridge.maze import Maze, maze_names
 from sim_bridge.robots.adapters import check_design
 
 #: Highest ROS_DOMAIN_ID: DDS derives UDP ports from it, and above 232 they pass 65535.
@@ -93,6 +100,8 @@ def parse_args(argv=None) -> argparse.Namespace:
         "(ros2 bag info and Foxglove open it; evorbc-play plays it back)",
     )
     p.add_argument("--quiet", action="store_true", help="only the result line")
+    # Not an option: prepare() sets the maze's factor (0 until then: the bridge fits it).
+    p.set_defaults(maze_scale=0.0)
     return p.parse_args(argv)
 
 
@@ -176,6 +185,7 @@ def start_graph(
         seed=args.seed,
         result_file=result_file,
         bag=args.bag,
+        maze_scale=args.maze_scale,
     )
     procs = [graph.start(node, spec.namespace) for node in spec.nodes]
     return procs[-1]  # the bridge, started last: it waits for the others anyway
@@ -229,7 +239,16 @@ def prepare(args: argparse.Namespace) -> tuple[Controller, Maze, str]:
     robot = registry.lookup(arb.robot)
     check_design(robot, controller)  # e.g. the hexapod: the bridge's design and laser
     args.maze = args.maze or robot.maze
-    maze = load_named_maze(args.maze)
+    # The maze of the offline episode: scaled by the factor the controller's task recorded,
+    # else fitted to the robot as offline runs fit it, with the same warning line.
+    from sim_bridge.maze_fit import load_fitted_maze  # scipy: not for --help
+
+    recorded = recorded_maze_scale(arb_path, args.maze)
+    maze, args.maze_scale, warning = load_fitted_maze(
+        args.maze, robot.footprint_radius, arb.robot, recorded
+    )
+    if warning:
+        report(warning)
     check_start(args.start, args.seed, maze, arb.robot)
     plot = args.plot or f"{maze.name}-run.png"
     check_output_file(plot, "--plot", picture=True)

@@ -9,7 +9,8 @@ rclpy nor ``launch``, so the launch logic is tested wherever the project's tests
 Both fill in the same defaults: the robot's shipped controller when no arbitrator is given
 (its paper-protocol one with ``paper``; none for a 4WS type other than 4ws-5: the
 arbitrator node then refuses to start and says how to make one), the robot's maze,
-the episode length the controller was evolved with (its file's task), simulated time for
+the episode length the controller was evolved with (its file's task), the factor its task
+recorded for the maze when the maze was scaled to fit the robot, simulated time for
 the four evorbc nodes, each node's parameter file ``config/ros/<node>.yaml``, the
 ``robot`` parameter on the arbitrator, which refuses a controller for another robot, and
 which nodes are lifecycle nodes (the launch file drives their transitions).
@@ -19,6 +20,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -181,6 +183,45 @@ def rangefinder_reach(arbitrator: str) -> float | None:
     return reach if math.isfinite(reach) and reach > 0 else None
 
 
+def recorded_maze_scale(arbitrator: str, maze: str) -> float | None:
+    """The factor ``arbitrator``'s task recorded for ``maze`` (name or file), if it has one.
+
+    An offline run scales a maze its robot does not fit and records the factor with its
+    task (``maze_scale``, docs/design.md section 21); replays apply the recorded factor, so
+    the graph does too, and drives the very maze of the offline episode. None when the
+    task records no factor for this maze (the bridge then fits the maze itself, as an
+    offline run without a record does), or the file cannot be read.
+    """
+    try:
+        task = _recorded(arbitrator)["evolution"]["task"]
+        mazes, scales = task["mazes"], task["maze_scale"]
+    except (KeyError, TypeError):
+        return None
+    if not (isinstance(mazes, list) and isinstance(scales, list) and len(mazes) == len(scales)):
+        return None
+    for name, factor in zip(mazes, scales, strict=True):
+        number = isinstance(factor, int | float) and not isinstance(factor, bool)
+        if number and 1.0 <= factor <= 100.0 and _same_maze(name, maze):
+            return float(factor)
+    return None
+
+
+def _same_maze(recorded, maze: str) -> bool:
+    """True if a task's maze entry and the graph's ``maze`` name the same maze."""
+    if not isinstance(recorded, str):
+        return False
+    if recorded == maze:
+        return True
+    from sim_bridge.maze import is_maze_file  # numba-compiled geometry: only when needed
+
+    if not (is_maze_file(recorded) and is_maze_file(maze)):
+        return False
+    try:
+        return os.path.samefile(recorded, maze)
+    except OSError:
+        return False
+
+
 def _recorded(arbitrator: str) -> dict:
     """The JSON of the file ``arbitrator`` names; {} if none is named or it cannot be read."""
     if not arbitrator:
@@ -225,12 +266,16 @@ def sim_graph(
     record_file: str = "",
     paper: bool = False,
     bag: str = "",
+    maze_scale: float = 0.0,
 ) -> SimGraph:
     """The graph that runs ``arbitrator`` (default: the one shipped for ``robot``) in a maze.
 
     ``paper`` picks the robot's shipped paper-protocol arbitrator instead of its default.
     ``bag``: a recorder node, started first, records the run into this rosbag2 folder, and
     the bridge holds its first state until the recorder hears every topic.
+    ``maze_scale``: the factor the bridge scales the maze by (>= 1); 0: the one the
+    controller's task recorded for this maze, else the bridge fits the maze to the robot as
+    offline runs do (docs/design.md section 21).
 
     Raises:
         ConfigError: an unknown robot or mode, or ``paper`` with ``arbitrator`` (one line
@@ -246,6 +291,8 @@ def sim_graph(
             "controller shipped for robot"
         )
     arbitrator = arbitrator or shipped_arbitrator(robot, paper)
+    maze = maze or default_maze(robot)
+    maze_scale = maze_scale or recorded_maze_scale(arbitrator, maze) or ""
     sim_time = {"use_sim_time": True}
 
     def evorbc(name: str, managed: bool = False, **params) -> NodeSpec:
@@ -289,7 +336,8 @@ def sim_graph(
                 _given(
                     {
                         "robot": robot,
-                        "maze": maze or default_maze(robot),
+                        "maze": maze,
+                        "maze_scale": maze_scale,
                         "mode": mode,
                         "gui": gui,
                         "start": start,
