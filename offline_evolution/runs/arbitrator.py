@@ -145,9 +145,9 @@ def arbitrator_run(
     """
     from offline_evolution.arbitrator.evolve import CHECKPOINT_KIND, evolve
 
-    plan = _plan(run)
-    checkpoint = plan.outputs.checkpoint
     report = Reporters(reporters)
+    plan = _plan(run, report)
+    checkpoint = plan.outputs.checkpoint
     with exclusive_outputs(plan.outputs.files):
         if run.restart:
             restart_from_scratch(checkpoint, CHECKPOINT_KIND, "NEAT evolution checkpoint")
@@ -176,8 +176,8 @@ def arbitrator_run(
     )
 
 
-def _plan(run: ArbitratorRun) -> _Plan:
-    """Check everything and resolve the settings, before any work."""
+def _plan(run: ArbitratorRun, report: Reporter) -> _Plan:
+    """Check everything and resolve the settings, before any work (warnings to ``report``)."""
     from evorbc_ros.config import config_dir
     from evorbc_ros.sensors import SensorLayout
     from offline_evolution.arbitrator.evolve import EvolutionSettings, file_sha256
@@ -197,7 +197,7 @@ def _plan(run: ArbitratorRun) -> _Plan:
     neat_file = Path(run.neat_config) if run.neat_config else settings_file.neat_path()
     task_source = str(run.task or settings_file.task_path())
     task_settings = MazeTaskSettings.load(run.task or settings_file.task_path())
-    task_settings = _check_mazes(task_settings, run.seed, robot, task_source)
+    task_settings = _check_mazes(task_settings, run.seed, robot, task_source, report)
     # The NEAT settings, the task's sensor layout and a network to start from, before any
     # work.
     layout = SensorLayout.load(config_dir() / task_settings.sensors)
@@ -242,12 +242,13 @@ def _plan(run: ArbitratorRun) -> _Plan:
     return _Plan(settings, repertoire, task_settings, initial_network, every, outputs)
 
 
-def _check_mazes(task_settings, seed: int, robot: str, source: str):
+def _check_mazes(task_settings, seed: int, robot: str, source: str, report: Reporter):
     """The task settings with its mazes fitted to the robot; refuse held-out mazes and seeds.
 
-    A maze the robot does not fit is scaled up to fit it (one warning line) and the scale
-    recorded with the task (docs/design.md section 21); a maze no scale fits is refused
-    before any work. Held out: docs/design.md section 22.
+    A maze the robot does not fit is scaled up to fit it (one ``report.warning`` line)
+    and the scale recorded with the task, so that the tasks built from the recorded
+    settings later say nothing again (docs/design.md section 21); a maze no scale fits is
+    refused before any work. Held out: docs/design.md section 22.
     """
     from evorbc_ros.config import ConfigError
     from offline_evolution.maze_task.base import fit_task_mazes
@@ -255,7 +256,7 @@ def _check_mazes(task_settings, seed: int, robot: str, source: str):
 
     try:
         task_settings, task_mazes = fit_task_mazes(
-            task_settings, lookup(robot).footprint_radius, robot
+            task_settings, lookup(robot).footprint_radius, robot, report.warning
         )
     except ConfigError as e:
         raise UserError(f"{source}: {e}") from None
