@@ -70,6 +70,7 @@ from evorbc_ros.nodes.diagnostics import DiagnosticsPublisher
 from evorbc_ros.nodes.parameters import ParameterGuard, declare_all
 from evorbc_ros.robots import registry
 from sim_bridge.bridge_parameters import PARAMETERS, REMOVED
+from sim_bridge.verdict import episode_verdict
 
 #: Topics of the graph besides the commands: each has exactly one publisher in one run.
 GRAPH_TOPICS = (
@@ -456,18 +457,6 @@ class SimBridgeNode(Node):
         if self.context.ok():
             self.get_logger().info(f"{episode_verdict(result)}; fitness {s.fitness:.3f}")
         return result
-
-
-def episode_verdict(result: dict) -> str:
-    """One phrase for a result: reached, fell over, interrupted, or where the time ran out."""
-    if result["reached"]:
-        return f"reached the target in {result['time']:.1f} s"
-    left = f"{result['final_distance']:.2f} m left"
-    if result.get("fell"):
-        return f"fell over after {result['time']:.1f} s ({left})"
-    if result.get("interrupted"):
-        return f"interrupted after {result['time']:.1f} s ({left})"
-    return f"did not reach the target ({left} after {result['time']:.1f} s)"
 
 
 def main(argv=None) -> int:
