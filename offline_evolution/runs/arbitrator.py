@@ -54,6 +54,7 @@ class ArbitratorRun:
     out: str  # the arbitrator file (JSON)
     plot: str | None = None  # fitness curve (PNG; default OUT with .fitness.png)
     population: int | None = None  # in place of the NEAT file's pop_size
+    hall_of_fame: int | None = None  # genomes kept for the post-selection
     post_samples: int | None = None  # random starts per maze in the post-selection
     config: str | None = None  # run settings (YAML)
     neat_config: str | None = None  # NEAT settings (neat-python INI)
@@ -209,9 +210,11 @@ def _plan(run: ArbitratorRun, report: Reporter) -> _Plan:
         initial_network = load_initial_network(
             run.init_from, robot, run.kind, mapping, layout, neat_config, str(neat_file)
         )
+    # The post-selection's size: the run settings', or the options that replace them.
     selection = settings_file.selection()
-    if run.post_samples is not None:
-        selection["post_samples"] = run.post_samples
+    for key in ("hall_of_fame", "post_samples"):
+        if getattr(run, key) is not None:
+            selection[key] = getattr(run, key)
     settings = EvolutionSettings(
         kind=run.kind,
         robot=robot,
@@ -276,7 +279,7 @@ def _check_memory(run, settings_file, task_settings, neat_config, settings, sour
         neat_config.pop_size,
         settings.robot,
         source,
-        3 * settings_file.hall_of_fame + snapshots,
+        3 * settings.hall_of_fame + snapshots,
         settings.post_samples,
         settings_file.post_finalists,
         settings_file.post_final_samples,
