@@ -32,6 +32,7 @@ from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.sensors import SensorLayout
 from evorbc_ros.settings_paths import resolve_beside
+from offline_evolution.maze_task.perturbation import is_set_file
 from offline_evolution.maze_task.training import TrainingMazes, TrainingSettings, check_training
 from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.maze import Maze, is_maze_file, load_named_maze
@@ -157,9 +158,10 @@ def task_file_values(path: str | os.PathLike) -> dict:
     """A task file's mapping with its relative paths resolved beside it.
 
     ``sensors`` as recorded tasks name it (relative to ``config/`` within the checkout,
-    else absolute), maze files absolute, maze names as they are; an old location (``config/``
-    for ``sensors``, the working directory for maze files) still works with a deprecation
-    line (:func:`~evorbc_ros.settings_paths.resolve_beside`).
+    else absolute), maze files and a ``training.perturb`` set file absolute, maze and set
+    names as they are; an old location (``config/`` for ``sensors``, the working directory
+    for maze and set files) still works with a deprecation line
+    (:func:`~evorbc_ros.settings_paths.resolve_beside`).
     """
     values = load_yaml_mapping(path)
     source = str(path)
@@ -174,6 +176,14 @@ def task_file_values(path: str | os.PathLike) -> dict:
             else m
             for k, m in enumerate(values["mazes"])
         ]
+    training = values.get("training")
+    perturb = training.get("perturb") if isinstance(training, dict) else None
+    if isinstance(perturb, str) and is_set_file(perturb):  # a set's name stays a name
+        where = "training.perturb"
+        values["training"] = {
+            **training,
+            "perturb": resolve_beside(perturb, source, where, Path.cwd()),
+        }
     return values
 
 
