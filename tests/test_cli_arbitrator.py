@@ -57,15 +57,23 @@ def test_the_population_and_the_post_selection_size_are_options(
     argv = ["arbitrator", "--repertoire", rep, "--generations", 2, "--seed", 2, "--quiet"]
     argv += ["--neat-config", small_neat_file, "--task", small_task_file]
     out = tmp_path / "a.json"
-    code, _, err = run(capsys, *argv, "--population", 12, "--post-samples", 1, "--out", out)
+    options = ["--population", 12, "--hall-of-fame", 1, "--post-samples", 1]
+    code, _, err = run(capsys, *argv, *options, "--out", out)
     assert code == 0, err
     evolution = ArbitratorFile.load(out).evolution
     assert evolution["population"] == 12  # recorded: the NEAT file says 24
-    assert evolution["post_evaluation"]["samples_per_maze"] == 1
+    post = evolution["post_evaluation"]
+    assert post["samples_per_maze"] == 1 and post["hall_of_fame"] == 1
+    # The best genome, the last generation's champion and one nominal reacher at most.
+    assert 1 <= post["candidates"] <= 3
     code, _, err = run(capsys, *argv, "--out", tmp_path / "b.json")
     assert code == 0, err
     evolution = ArbitratorFile.load(tmp_path / "b.json").evolution
     assert "population" not in evolution  # the file's pop_size: files as before
+    default = evolution["post_evaluation"]  # the run settings' (config/arbitrator/4ws.yaml)
+    assert default["hall_of_fame"] == 25 and default["samples_per_maze"] == 10
+    assert default["candidates"] > 3
+    assert default["episodes_per_candidate"] > post["episodes_per_candidate"]
     # A population the file's species settings cannot hold is refused in one line.
     code, _, err = run(capsys, *argv, "--population", 3, "--out", tmp_path / "c.json")
     assert code != 0 and len(err.strip().splitlines()) == 1 and "pop_size 3" in err, err

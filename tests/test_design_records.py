@@ -70,3 +70,47 @@ def test_a_repertoire_of_this_design_is_accepted():
         task.close()
     with pytest.raises(ValueError, match=r"rep\.json: was evolved for a different robot"):
         check_simulation(tripod_repertoire(), {"geometry": {}}, "rep.json")
+
+
+def test_evorbc_sim_refuses_another_laser_naming_the_first_setting_that_differs(tmp_path):
+    # The A1 controller with the hexapod's laser (2 m where the A1's reaches 2.5 m): the
+    # refusal names that one setting, not both layouts (issue 41).
+    from evorbc_ros.arbitration import Controller
+    from evorbc_ros.arbitrator import ArbitratorFile
+    from evorbc_ros.config import ConfigError, config_dir
+    from evorbc_ros.defaults import default_arbitrator, default_repertoire
+    from evorbc_ros.robots.registry import lookup
+    from evorbc_ros.sensors import SensorLayout
+    from sim_bridge.robots.adapters import check_design
+
+    shipped = ArbitratorFile.load(default_arbitrator("a1"))
+    hexapod_laser = SensorLayout.load(config_dir() / "sensors" / "hexapod.yaml")
+    path = tmp_path / "a1-other-laser.json"
+    dataclasses.replace(shipped, sensors=hexapod_laser).save(path)
+    controller = Controller(str(path), str(default_repertoire("a1")))
+    with pytest.raises(ConfigError) as e:
+        check_design(lookup("a1"), controller)
+    laser_file = lookup("a1").sensors_file()
+    assert str(e.value) == (
+        f"{path}: its sensor layout differs from the laser the bridge simulates for a1 "
+        f"({laser_file}: rangefinders.range is 2.0 in the controller but 2.5 now)"
+    )
+    check_design(lookup("a1"), Controller(str(default_arbitrator("a1"))))  # its own passes
+
+
+def test_the_arbitrator_names_the_first_sensor_setting_that_differs():
+    from evorbc_ros.arbitrator import ArbitratorError, ArbitratorFile
+    from evorbc_ros.config import config_dir
+    from evorbc_ros.defaults import default_arbitrator
+    from evorbc_ros.sensors import SensorLayout
+
+    arb = ArbitratorFile.load(default_arbitrator("4ws-5"))
+    other = SensorLayout.load(config_dir() / "sensors" / "hexapod.yaml")
+    with pytest.raises(ArbitratorError) as e:
+        arb.check_sensors(other, "hexapod.yaml")
+    line = str(e.value)
+    assert line.startswith(
+        "sensor layout hexapod.yaml differs from the arbitrator's (goal_bearing is None in "
+        "the arbitrator but True now)"
+    ), line
+    assert len(line) < 160

@@ -148,8 +148,13 @@ def test_files_without_a_kind_are_not_robots_and_a_missing_file_is_named(user_ro
         read_robot_file(user_robots / "other.yaml")
     text = BURGER.read_text().replace("neat/4ws.ini", "neat/nosuch.ini")
     write(user_robots / "typo.yaml", text)
-    with pytest.raises(ConfigError, match=r"typo\.yaml: settings\.neat: no such file neat/nosuch"):
+    with pytest.raises(ConfigError) as e:
         read_robot_file(user_robots / "typo.yaml")
+    assert str(e.value) == (
+        f"{user_robots / 'typo.yaml'}: settings.neat: no such file "
+        f"{(user_robots / 'neat/nosuch.ini').resolve()} (relative paths are from this file's "
+        "folder)"
+    )
 
 
 # -- a user's robot through the whole pipeline ------------------------------------------
@@ -217,6 +222,10 @@ def pipeline(tmp_path_factory):
     for key in ("repertoire", "arbitrator", "task"):
         burger = burger.replace(f"  {key}: ", f"  {key}: {key}.yaml  # ", 1)
     burger = burger.replace("  neat: neat/4ws.ini", "  neat: neat.ini")
+    # Relative paths are from the file's folder: the Burger's layout goes beside it.
+    layout = "sensors/turtlebot3-burger.yaml"
+    (folder / "burger-sensors.yaml").write_text((config_dir() / layout).read_text())
+    burger = burger.replace(f"sensors: {layout}", "sensors: burger-sensors.yaml")
     burger = burger.replace("maze: zigzag", "maze: gaps").replace(
         "episode_time: 120.0", "episode_time: 15.0"
     )

@@ -61,7 +61,10 @@ def test_a_legged_robot_file_registers_a_robot_that_walks_as_its_model(user_robo
 @pytest.mark.parametrize(
     ("edit", "message"),
     [
-        (("model: mydog-model.yaml", "model: nothere.yaml"), "model: no such file nothere.yaml"),
+        (
+            ("model: mydog-model.yaml", "model: nothere.yaml"),
+            r"model: no such file \S*/nothere.yaml \(relative",
+        ),
         (("model: mydog-model.yaml\n", ""), "model: expected the legged settings file"),
         (("kind: legged", "kind: diff_drive"), "model is for legged robots; remove it"),
         (("kind: legged", "kind: legged\ntype: 4ws-5"), "type and geometry are not for legged"),

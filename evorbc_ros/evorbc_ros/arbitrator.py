@@ -242,13 +242,8 @@ class ArbitratorFile:
         """
         if layout.fingerprint() == self.sensors.fingerprint():
             return []
-        mine, theirs = layout.input_names(), self.sensors.input_names()
-        if mine == theirs:  # the same inputs, other settings: name those
-            a, b = layout.to_dict(), self.sensors.to_dict()
-            keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
-            what = "; ".join(f"{k}: {a.get(k)} vs {b.get(k)}" for k in keys)
-        else:
-            what = f"{mine} vs {theirs}"
+        # The first setting that differs, not both layouts: a short line whatever they hold.
+        what = layout.difference(self.sensors, "the arbitrator")
         message = f"sensor layout {source} differs from the arbitrator's ({what})"
         return _mismatch(message, allow_mismatch, waiver)
 

@@ -163,6 +163,16 @@ class SensorLayout:
             out["motion"] = {"window": self.motion.window, "distance": self.motion.distance}
         return out
 
+    def difference(self, expected: SensorLayout, where: str) -> str | None:
+        """The first setting in which this layout differs from ``expected``, in one short line.
+
+        ``rangefinders.range is 2.0 in <where> but 2.5 now``: ``where`` names what holds
+        ``expected`` (``the arbitrator``); None when the layouts are the same.
+        """
+        from evorbc_ros.json_files import first_difference
+
+        return first_difference(expected.to_dict(), self.to_dict(), where)
+
     def fingerprint(self) -> str:
         """Short hash of the layout; arbitrators record it to detect a different layout."""
         text = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))

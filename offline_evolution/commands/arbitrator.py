@@ -29,6 +29,14 @@ def _common_options(p: argparse.ArgumentParser) -> None:
         "elitism settings must fit it)",
     )
     p.add_argument(
+        "--hall-of-fame",
+        type=integer_in(1, bounds.POP_SIZE),
+        metavar="N",
+        help="genomes kept for the post-selection, the N best by training fitness, the last "
+        "N generations' champions and up to N seen reaching from every nominal start "
+        "(default: the run settings'; fewer candidates are quicker)",
+    )
+    p.add_argument(
         "--post-samples",
         type=integer_in(1, bounds.MAZES),
         metavar="N",

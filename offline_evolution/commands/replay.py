@@ -16,6 +16,7 @@ from sim_bridge.cli_options import (
     add_seed,
     add_task,
 )
+from sim_bridge.verdict import episode_line
 
 #: Where an EvoRBC arbitrator's repertoire comes from without --repertoire
 #: (:func:`offline_evolution.runs.replay.resolve_repertoire`).
@@ -111,11 +112,9 @@ def _as_json(done, run, summary: list[dict]) -> dict:
 
 
 def _print_episodes(outcomes) -> None:
-    """One line per episode: reached, time and fitness."""
-    print(f"{'maze':<12} {'reached':>7} {'time (s)':>9} {'fitness':>8}")
+    """One line per episode, as ``evorbc-sim`` says it: reached, fell or missed, and when."""
     for o in outcomes:
-        status = "yes" if o.reached else ("fell" if o.fell else "no")
-        print(f"{o.maze:<12} {status:>7} {o.time:>9.1f} {o.fitness:>8.3f}")
+        print(episode_line(o.maze, o.as_dict()))
 
 
 def _print_summary(summary: list[dict]) -> None:

@@ -32,6 +32,7 @@ from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.primitive import ParameterSpec
 from evorbc_ros.sensors import SensorLayout
 from evorbc_ros.settings_paths import resolve_beside
+from offline_evolution.maze_task.perturbation import is_set_file
 from offline_evolution.maze_task.training import TrainingMazes, TrainingSettings, check_training
 from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.maze import Maze, is_maze_file, load_named_maze
@@ -157,9 +158,10 @@ def task_file_values(path: str | os.PathLike) -> dict:
     """A task file's mapping with its relative paths resolved beside it.
 
     ``sensors`` as recorded tasks name it (relative to ``config/`` within the checkout,
-    else absolute), maze files absolute, maze names as they are; an old location (``config/``
-    for ``sensors``, the working directory for maze files) still works with a deprecation
-    line (:func:`~evorbc_ros.settings_paths.resolve_beside`).
+    else absolute), maze files and a ``training.perturb`` set file absolute, maze and set
+    names as they are; an old location (``config/`` for ``sensors``, the working directory
+    for maze and set files) still works with a deprecation line
+    (:func:`~evorbc_ros.settings_paths.resolve_beside`).
     """
     values = load_yaml_mapping(path)
     source = str(path)
@@ -174,26 +176,38 @@ def task_file_values(path: str | os.PathLike) -> dict:
             else m
             for k, m in enumerate(values["mazes"])
         ]
+    training = values.get("training")
+    perturb = training.get("perturb") if isinstance(training, dict) else None
+    if isinstance(perturb, str) and is_set_file(perturb):  # a set's name stays a name
+        where = "training.perturb"
+        values["training"] = {
+            **training,
+            "perturb": resolve_beside(perturb, source, where, Path.cwd()),
+        }
     return values
 
 
 def fit_task_mazes(
-    settings: MazeTaskSettings, footprint_radius: float, robot: str = "the robot"
+    settings: MazeTaskSettings,
+    footprint_radius: float,
+    robot: str = "the robot",
+    warn: Callable[[str], None] | None = None,
 ) -> tuple[MazeTaskSettings, list[Maze]]:
     """The task's mazes, each scaled up to fit the robot, and the settings recording it.
 
     A maze whose factor ``settings.maze_scale`` records is scaled by it; any other is
     scaled by the smallest factor that fits (:func:`~sim_bridge.maze_fit.fit_scale`,
-    docs/design.md section 21), with one warning line on stderr naming the maze, the factor
-    and why. The settings returned record every factor (``maze_scale``) when one is not 1,
-    else they are ``settings`` unchanged.
+    docs/design.md section 21), and ``warn`` is called with one line naming the maze, the
+    factor and why. Nothing is printed here: a run passes its reporters' ``warning``, so
+    that the command line, a study and a recipe each say it their way, once. The settings
+    returned record every factor (``maze_scale``) when one is not 1, else they are
+    ``settings`` unchanged.
 
     Raises:
         ConfigError: no scale fits a maze, or a recorded scale leaves the robot's
             footprint touching a wall at the maze's nominal start (replay, the
             post-selection and the ROS bridge start there).
     """
-    from evorbc_ros.robots.adapters import report
     from sim_bridge.maze_fit import fitted_maze
 
     recorded = settings.maze_scale or (None,) * len(settings.mazes)
@@ -204,8 +218,8 @@ def fit_task_mazes(
             maze, factor_used, warning = fitted_maze(loaded, footprint_radius, robot, factor)
         except ValueError as e:
             raise ConfigError(f"mazes: {e}") from None
-        if warning and factor is None:
-            report(warning)
+        if warning and factor is None and warn is not None:
+            warn(warning)
         misfit = maze.start_misfit(footprint_radius, robot)
         if misfit:
             raise ConfigError(f"mazes: {misfit}")
@@ -264,9 +278,13 @@ class MazeTaskBase(abc.ABC):
         footprint_radius: float,
         robot_name: str = "the robot",
     ):
-        # A maze the robot does not fit is scaled up to fit it (a warning line, unless
-        # the scale is the recorded one): see :func:`fit_task_mazes`.
-        settings, mazes = fit_task_mazes(settings, footprint_radius, robot_name)
+        #: Warnings of building the task (a maze scaled up to fit the robot, unless the
+        #: scale is the recorded one: :func:`fit_task_mazes`), for the run that made the
+        #: task to tell through its reporters; the task prints nothing.
+        self.warnings: list[str] = []
+        settings, mazes = fit_task_mazes(
+            settings, footprint_radius, robot_name, self.warnings.append
+        )
         self.settings = settings
         #: The task's own mazes (``settings.mazes``), always first in :attr:`mazes`.
         self.task_mazes: tuple[Maze, ...] = tuple(mazes)

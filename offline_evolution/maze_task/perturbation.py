@@ -220,6 +220,11 @@ def perturbation_dir() -> Path:
     return config_dir() / "perturbations"
 
 
+def is_set_file(name_or_path: str) -> bool:
+    """True if ``name_or_path`` names a perturbation set file (a path), not a set's name."""
+    return name_or_path.endswith((".yaml", ".yml")) or os.sep in name_or_path
+
+
 def load_perturbations(name_or_path: str | os.PathLike) -> PerturbationSet:
     """``none``, a shipped set by name (``realistic``) or a set file by path.
 
@@ -229,7 +234,7 @@ def load_perturbations(name_or_path: str | os.PathLike) -> PerturbationSet:
     text = str(name_or_path)
     if text == "none":
         return NONE
-    if not text.endswith((".yaml", ".yml")) and os.sep not in text:
+    if not is_set_file(text):
         path = perturbation_dir() / f"{text}.yaml"
         if not path.is_file():
             known = sorted(p.stem for p in perturbation_dir().glob("*.yaml"))

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from offline_evolution.maze_task.task import EpisodeResult, MazeTask
 from sim_bridge.maze_plot import PATH_CMAP, add_episode_legend, draw_episode
 from sim_bridge.plotting import plt, save_figure
+from sim_bridge.verdict import episode_line
 
 
 def trajectories_figure(task: MazeTask, outcomes: Sequence, result: EpisodeResult, title: str = ""):
@@ -39,12 +40,7 @@ def trajectories_figure(task: MazeTask, outcomes: Sequence, result: EpisodeResul
             ax, mazes[o.maze], result.pose[e, : cycles + 1], task.dt, norm, linewidth=1.6
         )
         legend = legend or artists  # every row draws the same kinds of things
-        verdict = (
-            f"reached in {o.time:.1f} s"
-            if o.reached
-            else f"not reached, {o.final_distance:.2f} m left"
-        )
-        ax.set_title(f"{o.maze}: {verdict}, fitness {o.fitness:.3f}", fontsize=10)
+        ax.set_title(episode_line(o.maze, o.as_dict()), fontsize=10)  # as evorbc-sim says it
     fig.colorbar(
         plt.cm.ScalarMappable(norm=norm, cmap=PATH_CMAP),
         ax=list(axes[:, 0]),

@@ -54,6 +54,7 @@ class ArbitratorRun:
     out: str  # the arbitrator file (JSON)
     plot: str | None = None  # fitness curve (PNG; default OUT with .fitness.png)
     population: int | None = None  # in place of the NEAT file's pop_size
+    hall_of_fame: int | None = None  # genomes kept for the post-selection
     post_samples: int | None = None  # random starts per maze in the post-selection
     config: str | None = None  # run settings (YAML)
     neat_config: str | None = None  # NEAT settings (neat-python INI)
@@ -145,9 +146,9 @@ def arbitrator_run(
     """
     from offline_evolution.arbitrator.evolve import CHECKPOINT_KIND, evolve
 
-    plan = _plan(run)
-    checkpoint = plan.outputs.checkpoint
     report = Reporters(reporters)
+    plan = _plan(run, report)
+    checkpoint = plan.outputs.checkpoint
     with exclusive_outputs(plan.outputs.files):
         if run.restart:
             restart_from_scratch(checkpoint, CHECKPOINT_KIND, "NEAT evolution checkpoint")
@@ -176,8 +177,8 @@ def arbitrator_run(
     )
 
 
-def _plan(run: ArbitratorRun) -> _Plan:
-    """Check everything and resolve the settings, before any work."""
+def _plan(run: ArbitratorRun, report: Reporter) -> _Plan:
+    """Check everything and resolve the settings, before any work (warnings to ``report``)."""
     from evorbc_ros.config import config_dir
     from evorbc_ros.sensors import SensorLayout
     from offline_evolution.arbitrator.evolve import EvolutionSettings, file_sha256
@@ -197,7 +198,7 @@ def _plan(run: ArbitratorRun) -> _Plan:
     neat_file = Path(run.neat_config) if run.neat_config else settings_file.neat_path()
     task_source = str(run.task or settings_file.task_path())
     task_settings = MazeTaskSettings.load(run.task or settings_file.task_path())
-    task_settings = _check_mazes(task_settings, run.seed, robot, task_source)
+    task_settings = _check_mazes(task_settings, run.seed, robot, task_source, report)
     # The NEAT settings, the task's sensor layout and a network to start from, before any
     # work.
     layout = SensorLayout.load(config_dir() / task_settings.sensors)
@@ -209,9 +210,11 @@ def _plan(run: ArbitratorRun) -> _Plan:
         initial_network = load_initial_network(
             run.init_from, robot, run.kind, mapping, layout, neat_config, str(neat_file)
         )
+    # The post-selection's size: the run settings', or the options that replace them.
     selection = settings_file.selection()
-    if run.post_samples is not None:
-        selection["post_samples"] = run.post_samples
+    for key in ("hall_of_fame", "post_samples"):
+        if getattr(run, key) is not None:
+            selection[key] = getattr(run, key)
     settings = EvolutionSettings(
         kind=run.kind,
         robot=robot,
@@ -242,12 +245,13 @@ def _plan(run: ArbitratorRun) -> _Plan:
     return _Plan(settings, repertoire, task_settings, initial_network, every, outputs)
 
 
-def _check_mazes(task_settings, seed: int, robot: str, source: str):
+def _check_mazes(task_settings, seed: int, robot: str, source: str, report: Reporter):
     """The task settings with its mazes fitted to the robot; refuse held-out mazes and seeds.
 
-    A maze the robot does not fit is scaled up to fit it (one warning line) and the scale
-    recorded with the task (docs/design.md section 21); a maze no scale fits is refused
-    before any work. Held out: docs/design.md section 22.
+    A maze the robot does not fit is scaled up to fit it (one ``report.warning`` line)
+    and the scale recorded with the task, so that the tasks built from the recorded
+    settings later say nothing again (docs/design.md section 21); a maze no scale fits is
+    refused before any work. Held out: docs/design.md section 22.
     """
     from evorbc_ros.config import ConfigError
     from offline_evolution.maze_task.base import fit_task_mazes
@@ -255,7 +259,7 @@ def _check_mazes(task_settings, seed: int, robot: str, source: str):
 
     try:
         task_settings, task_mazes = fit_task_mazes(
-            task_settings, lookup(robot).footprint_radius, robot
+            task_settings, lookup(robot).footprint_radius, robot, report.warning
         )
     except ConfigError as e:
         raise UserError(f"{source}: {e}") from None
@@ -275,7 +279,7 @@ def _check_memory(run, settings_file, task_settings, neat_config, settings, sour
         neat_config.pop_size,
         settings.robot,
         source,
-        3 * settings_file.hall_of_fame + snapshots,
+        3 * settings.hall_of_fame + snapshots,
         settings.post_samples,
         settings_file.post_finalists,
         settings_file.post_final_samples,

@@ -93,6 +93,8 @@ def _evaluate(run: EvaluateRun, report: Reporters) -> EvaluateOutcome:
     arb, arb_path = load_arbitrator(run)
     repertoire, rep_path, base = controller_inputs(arb, arb_path, run, report)
     task = _suite_task(run, arb, base)
+    for w in task.warnings:  # a maze of the suite scaled to fit the robot
+        report.warning(w)
     try:
         check_task(task, arb, arb_path, repertoire, rep_path, run.allow_mismatch)
         controller = task.controller(arb.kind, repertoire, arb.mapping)

@@ -77,7 +77,7 @@ def replay_run(run: ReplayRun, reporters: Sequence[Reporter] = ()) -> ReplayOutc
         ConfigError, RepertoireError, ArbitratorError: a bad input file.
     """
     from offline_evolution.maze_task.replay import replay
-    from offline_evolution.maze_task.task import MazeTaskSettings, make_task
+    from offline_evolution.maze_task.task import make_task
 
     report = Reporters(reporters)
     arb_path = Path(run.arbitrator)
@@ -92,10 +92,12 @@ def replay_run(run: ReplayRun, reporters: Sequence[Reporter] = ()) -> ReplayOutc
     repertoire, rep_path, settings = controller_inputs(arb, arb_path, run, report)
     recorded = arb.evolution.get("task")
     if run.maze != "all":
-        settings = MazeTaskSettings((run.maze,), settings.episode_time, 1, settings.sensors)
+        settings = _one_maze(settings, run.maze)
     where = run.task or (f"{arb_path}: evolution.task" if recorded else "the default task")
     _check_memory(run, arb, settings, where)
     task = make_task(settings, arb.robot)
+    for w in task.warnings:  # a maze scaled to fit the robot (a --task or --maze not recorded)
+        report.warning(w)
     try:
         check_task(task, arb, arb_path, repertoire, rep_path, run.allow_mismatch, where)
         task.progress = report.episodes_done  # many PyBullet episodes take minutes
@@ -110,6 +112,16 @@ def replay_run(run: ReplayRun, reporters: Sequence[Reporter] = ()) -> ReplayOutc
             )
     _draw(run, task, outcomes, result, arb, repertoire)
     return ReplayOutcome(arb, arb_path, repertoire, rep_path, outcomes)
+
+
+def _one_maze(settings, maze: str):
+    """``settings`` for the one maze ``maze``, keeping the scale recorded for it, if any."""
+    from offline_evolution.maze_task.base import MazeTaskSettings
+
+    scale = None
+    if settings.maze_scale is not None and maze in settings.mazes:
+        scale = (settings.maze_scale[settings.mazes.index(maze)],)
+    return MazeTaskSettings((maze,), settings.episode_time, 1, settings.sensors, maze_scale=scale)
 
 
 def _check_memory(run: ReplayRun, arb: ArbitratorFile, settings, where: str) -> None:

@@ -13,6 +13,7 @@ from offline_evolution.runs.console import (
     GenerationPrinter,
     IterationPrinter,
     PostEvaluationPrinter,
+    WarningPrinter,
 )
 from offline_evolution.runs.frame import StopOnSignal, explained
 from offline_evolution.runs.repertoire import RepertoireRun, repertoire_run
@@ -38,7 +39,8 @@ def arbitrator(run: ArbitratorRun, workers: int | None = None, quiet: bool = Fal
 
     The resume is said even if ``quiet`` (a study's run.log keeps it).
     """
-    reporters = [GenerationPrinter(quiet)] + ([] if quiet else [PostEvaluationPrinter()])
+    reporters = [GenerationPrinter(quiet), WarningPrinter()]
+    reporters += [] if quiet else [PostEvaluationPrinter()]
     # After the last generation the run stops between batches of its post-evaluation.
     stop = StopOnSignal("generation (or post-evaluation batch)")
     with explained("generation"):

@@ -70,6 +70,7 @@ from evorbc_ros.nodes.diagnostics import DiagnosticsPublisher
 from evorbc_ros.nodes.parameters import ParameterGuard, declare_all
 from evorbc_ros.robots import registry
 from sim_bridge.bridge_parameters import PARAMETERS, REMOVED
+from sim_bridge.verdict import episode_verdict
 
 #: Topics of the graph besides the commands: each has exactly one publisher in one run.
 GRAPH_TOPICS = (
@@ -487,18 +488,6 @@ def robot_maze(name: str, scale: float, footprint_radius: float, robot: str):
 def scaled(factor: float) -> str:
     """`` scaled xF`` for a maze scaled to fit the robot, "" for one as its file has it."""
     return "" if factor == 1.0 else f" scaled x{factor:g}"
-
-
-def episode_verdict(result: dict) -> str:
-    """One phrase for a result: reached, fell over, interrupted, or where the time ran out."""
-    if result["reached"]:
-        return f"reached the target in {result['time']:.1f} s"
-    left = f"{result['final_distance']:.2f} m left"
-    if result.get("fell"):
-        return f"fell over after {result['time']:.1f} s ({left})"
-    if result.get("interrupted"):
-        return f"interrupted after {result['time']:.1f} s ({left})"
-    return f"did not reach the target ({left} after {result['time']:.1f} s)"
 
 
 def main(argv=None) -> int:

@@ -34,7 +34,7 @@ from evorbc_ros.repertoire import RepertoireError
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.adapters import report
 from evorbc_ros.robots.registry import DEFAULT_ROBOT
-from sim_bridge.bridge_node import SimBridgeNode, episode_verdict
+from sim_bridge.bridge_node import SimBridgeNode
 from sim_bridge.cli_options import add_arbitrator, add_flag, add_repertoire, add_robot, add_seed
 from sim_bridge.cli_support import OneLineParser, check_output_file, integer_in, report_unexpected
 from sim_bridge.graph import (
@@ -46,6 +46,7 @@ from sim_bridge.graph import (
 )
 from sim_bridge.maze import Maze, maze_names
 from sim_bridge.robots.adapters import check_design
+from sim_bridge.verdict import episode_line, episode_verdict
 
 #: Highest ROS_DOMAIN_ID: DDS derives UDP ports from it, and above 232 they pass 65535.
 MAX_DOMAIN_ID = 232
@@ -342,7 +343,7 @@ def run(args: argparse.Namespace) -> int:
         result = json.loads(Path(result_file).read_text())
     verdict = episode_verdict(result)
     fitness = "" if result.get("interrupted") else f", fitness {result['fitness']:.3f}"
-    print(f"{maze.name}: {verdict}{fitness} ({args.mode}) -> {plot}")
+    print(f"{episode_line(maze.name, result)} ({args.mode}) -> {plot}")
     if args.bag:
         recorder = graph.procs["recorder"].returncode
         if recorder != 0:

@@ -14,7 +14,9 @@ URDF, joints, gait, servos, physics). Keys every kind takes:
 
 * ``kind``, ``name`` (default: the file's stem), ``description``;
 * ``settings``: ``repertoire``, ``arbitrator``, ``neat``, ``task`` files, and ``sensors``,
-  each beside this file if found there, else relative to evorbc's ``config/``;
+  relative paths from this file's folder (one found only in evorbc's ``config/``, where
+  they were taken from before, still works with a deprecation line; docs/design.md
+  section 12);
 * ``maze``, ``episode_time`` (s), ``equal_budget_generations``;
 * ``geometry``: the kind's body and limits (:class:`~evorbc_ros.robots.four_ws.FourWSGeometry`
   keys for ``four_ws``, which keep the paper's value for a key not given;
@@ -34,6 +36,7 @@ from typing import Any
 
 from evorbc_ros.config import ConfigError, build_settings, config_dir, load_yaml_mapping, setting
 from evorbc_ros.robots.record import Robot, SettingsFiles
+from evorbc_ros.settings_paths import resolve_beside
 
 #: The environment variable naming the user's folders of robot settings files.
 PATH_VARIABLE = "EVORBC_ROBOT_PATH"
@@ -89,17 +92,20 @@ def robot_files() -> list[Path]:
     return files
 
 
-def _resolve(value: str, folder: Path) -> str:
-    """A file named in a robot settings file, as the registration keeps it.
+def _resolve(value: str, source: Path, key: str, old: Path | None = None) -> str:
+    """A file named by key ``key`` of the robot settings file ``source``, as kept.
 
-    Beside the file if there (made absolute), else as given, relative to ``config/``;
-    absolute paths as they are.
+    Beside the file if there (made absolute); absolute paths as they are. Else from where
+    such paths used to be taken, ``old`` (default: evorbc's ``config/``), kept as given,
+    with one deprecation line unless ``source`` is one of evorbc's own files in
+    ``config/`` (:func:`~evorbc_ros.settings_paths.resolve_beside`); else the absolute
+    path beside the file, which the caller then reports missing.
     """
     path = Path(value).expanduser()
-    if path.is_absolute():
-        return str(path)
-    beside = folder / path
-    return str(beside.resolve()) if beside.is_file() else value
+    beside = source.resolve().parent / path
+    if path.is_absolute() or beside.is_file():
+        return str(beside.resolve())
+    return resolve_beside(value, source, key, old or config_dir(), config_dir())
 
 
 def read_robot_file(path: str | os.PathLike) -> Robot | None:
@@ -124,15 +130,14 @@ def read_robot_file(path: str | os.PathLike) -> Robot | None:
             f"{source}: settings must be a mapping of repertoire, arbitrator, neat, task"
         )
     files = build_settings(_SettingsKeys, files, f"{source}: settings")
-    folder = path.resolve().parent
     if keys.model is not None:
         if keys.kind != "legged":
             raise ConfigError(f"{source}: model is for legged robots; remove it")
-        keys = dataclasses.replace(keys, model=_resolve(keys.model, folder))
+        keys = dataclasses.replace(keys, model=_resolve(keys.model, path, "model"))
     builder = {"four_ws": _four_ws, "diff_drive": _diff_drive, "legged": _legged}[keys.kind]
     robot = builder(keys, geometry, source)
     given = {
-        f.name: _resolve(getattr(files, f.name), folder)
+        f.name: _resolve(getattr(files, f.name), path, f"settings.{f.name}")
         for f in dataclasses.fields(files)
         if getattr(files, f.name) is not None
     }
@@ -144,12 +149,15 @@ def read_robot_file(path: str | os.PathLike) -> Robot | None:
     if keys.description:
         changes["description"] = keys.description
     if keys.sensors is not None:
-        changes["sensors"] = _resolve(keys.sensors, folder)
+        changes["sensors"] = _resolve(keys.sensors, path, "sensors")
     for key in ("episode_time", "equal_budget_generations"):
         if getattr(keys, key) is not None:
             changes[key] = getattr(keys, key)
     if keys.maze is not None:
-        changes["maze"] = _resolve(keys.maze, folder)
+        # A maze file (a path: a YAML suffix or a folder part) was taken from the
+        # working directory; a shipped maze's name stays a name.
+        is_file = keys.maze.endswith((".yaml", ".yml")) or os.sep in keys.maze
+        changes["maze"] = _resolve(keys.maze, path, "maze", Path.cwd()) if is_file else keys.maze
     robot = dataclasses.replace(robot, **changes)
     _check_files(robot, source)
     return robot
@@ -166,8 +174,8 @@ def _check_files(robot: Robot, source: str) -> None:
         file = Path(value) if Path(value).is_absolute() else config_dir() / value
         if not file.is_file():
             raise ConfigError(
-                f"{source}: {key}: no such file {value} (looked beside this file and in "
-                f"{config_dir()})"
+                f"{source}: {key}: no such file {value} (relative paths are from this file's "
+                "folder)"
             )
 
 
@@ -214,7 +222,10 @@ def _legged(keys: RobotFileKeys, geometry: dict, source: str) -> Robot:
         raise ConfigError(f"{source}: model: expected the legged settings file (docs/legged.md)")
     model = Path(keys.model) if Path(keys.model).is_absolute() else config_dir() / keys.model
     if not model.is_file():
-        raise ConfigError(f"{source}: model: no such file {keys.model}")
+        raise ConfigError(
+            f"{source}: model: no such file {keys.model} (relative paths are from this "
+            "file's folder)"
+        )
     robot = legged_robot(str(model), "legged robot from its URDF")
     name = keys.name or Path(source).stem
     if robot.name != name:

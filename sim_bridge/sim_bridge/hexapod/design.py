@@ -7,13 +7,13 @@ refused in one line naming the first setting that differs (docs/design.md sectio
 
 from __future__ import annotations
 
-from evorbc_ros.config import ConfigError, config_dir
+from evorbc_ros.config import config_dir
 from evorbc_ros.robots.hexapod import HexapodGeometry
 from evorbc_ros.sensors import SensorLayout
 from sim_bridge.hexapod.maze_world import DEFAULT_SENSORS
 from sim_bridge.hexapod.physics import PhysicsSettings
 from sim_bridge.hexapod.robot import describe_simulation
-from sim_bridge.robots.design import check_controller_simulation
+from sim_bridge.robots.design import check_controller_laser, check_controller_simulation
 
 
 def check_controller(robot, controller) -> None:
@@ -27,15 +27,9 @@ def check_controller(robot, controller) -> None:
         ConfigError: one line naming the file and the first setting that differs.
 
     """
-    # The bridge simulates the shipped laser; the sensor nodes read its scans with the
-    # arbitrator's layout, so another layout would feed the network inputs it never saw.
+    # The bridge simulates the shipped laser (25 beams over +-90 deg, grouped into 5).
     laser = SensorLayout.load(config_dir() / DEFAULT_SENSORS)
-    if controller.spec.sensors.fingerprint() != laser.fingerprint():
-        raise ConfigError(
-            f"{controller.arbitrator_path}: its sensor layout differs from the laser the "
-            f"bridge simulates (config/{DEFAULT_SENSORS}: 25 beams over +-90 deg, grouped "
-            "into 5)"
-        )
+    check_controller_laser(controller, laser, f"config/{DEFAULT_SENSORS}", robot.name)
     check_controller_simulation(
         controller, describe_simulation(HexapodGeometry(), PhysicsSettings())
     )

@@ -8,10 +8,9 @@ the first setting that differs (docs/design.md section 11), as the hexapod's is.
 
 from __future__ import annotations
 
-from evorbc_ros.config import ConfigError
 from evorbc_ros.sensors import SensorLayout
 from sim_bridge.legged.settings import load_robot_settings
-from sim_bridge.robots.design import check_controller_simulation
+from sim_bridge.robots.design import check_controller_laser, check_controller_simulation
 
 
 def check_controller(robot, controller) -> None:
@@ -26,9 +25,5 @@ def check_controller(robot, controller) -> None:
 
     """
     laser_file = robot.sensors_file()
-    if controller.spec.sensors.fingerprint() != SensorLayout.load(laser_file).fingerprint():
-        raise ConfigError(
-            f"{controller.arbitrator_path}: its sensor layout differs from the laser the "
-            f"bridge simulates for {robot.name} ({laser_file})"
-        )
+    check_controller_laser(controller, SensorLayout.load(laser_file), laser_file, robot.name)
     check_controller_simulation(controller, load_robot_settings(robot.model.path()).describe())

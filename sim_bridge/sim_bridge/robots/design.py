@@ -12,6 +12,7 @@ from __future__ import annotations
 from evorbc_ros.config import ConfigError
 from evorbc_ros.json_files import first_difference
 from evorbc_ros.repertoire import Repertoire, RepertoireError
+from evorbc_ros.sensors import SensorLayout
 
 
 def simulation_mismatch(recorded: dict | None, simulation: dict | None, where: str) -> str | None:
@@ -39,6 +40,25 @@ def check_simulation(
     )
     if mismatch:
         raise RepertoireError(f"{source}: was evolved for a different robot ({mismatch})")
+
+
+def check_controller_laser(controller, laser: SensorLayout, laser_file, robot: str) -> None:
+    """Refuse a controller whose sensor layout is not the laser the bridge simulates.
+
+    The sensor nodes read the bridge's scans with the arbitrator's layout, so another
+    layout would feed the network inputs it never saw.
+
+    Raises:
+        ConfigError: one line naming the arbitrator file, the laser's file and the first
+            setting that differs (the controller's value, then the laser's).
+
+    """
+    what = laser.difference(controller.spec.sensors, "the controller")
+    if what:
+        raise ConfigError(
+            f"{controller.arbitrator_path}: its sensor layout differs from the laser the "
+            f"bridge simulates for {robot} ({laser_file}: {what})"
+        )
 
 
 def check_controller_simulation(controller, simulation: dict) -> None:
