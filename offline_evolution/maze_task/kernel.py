@@ -324,6 +324,10 @@ def run_episodes(
         width = controller.primitive_commands.shape[1]
     else:
         width = controller.gene_matrix.shape[1]
+    # Flags read every cycle, as locals: numba does not hoist NamedTuple loads out of the
+    # parallel loop; read from the tuples, the two cost 11 % of the cycles/s (A/B on CPU
+    # time, docs/performance.md "The episode kernel in steps").
+    recording, drawn = traces.on, draws.on
     for e in nb.prange(n_ep):
         g = genome[e]
         m = maze[e]
@@ -358,17 +362,17 @@ def run_episodes(
             cand = _sense(t, x, y, h, m, world, sensors, trail, inputs, noise_sd, dropout, key)
             _think(g, t, inputs, values, buffers, recurrent, out, net)
             choice = _decide(out, controller, lim, command)
-            if traces.on:
+            if recording:
                 _record(pose, choice_trace, output_trace, e, t, x, y, h, choice, out)
             for k in range(STATE_SIZE):
                 before[k] = state[e, k]
-            _act(state, e, t, command, draws.on, gain, pending, latency, lim, world.boxes, cand)
+            _act(state, e, t, command, drawn, gain, pending, latency, lim, world.boxes, cand)
             dist = math.hypot(state[e, X] - tx, state[e, Y] - ty)
             if dist <= world.target_radius[m]:
                 reached[e] = True
                 cycles[e] = t + 1
                 break
-            if not traces.on and not draws.on:
+            if not recording and not drawn:
                 # A fixed point: the whole state came back unchanged, so every later cycle
                 # reads the same sensors, gets the same outputs from the network and makes
                 # the same step. A feed-forward network is stateless; a recurrent one must
@@ -386,7 +390,7 @@ def run_episodes(
         final_distance[e] = dist
         end[e, 0] = state[e, X]
         end[e, 1] = state[e, Y]
-        if traces.on:  # the pose the last cycle run reached
+        if recording:  # the pose the last cycle run reached
             last = cycles[e]
             pose[e, last, 0] = state[e, X]
             pose[e, last, 1] = state[e, Y]
