@@ -97,15 +97,18 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         f"{done.perturbation}"
     )
     _print_table(report["per_maze"], report["overall"])
+    if report.get("per_damage"):
+        print(f"by damaged part ({report['perturbation']['damage']['kind']}):")
+        _print_table(report["per_damage"], None)
     return 0
 
 
-def _print_table(rows: list[dict], overall: dict) -> None:
+def _print_table(rows: list[dict], overall: dict | None) -> None:
     print(
         f"{'maze':<14} {'episodes':>8} {'reached':>7} {'reach %':>7} {'95 % interval':>13} "
         f"{'mean fitness':>12} {'stalls':>6} {'collisions':>10} {'falls':>5}"
     )
-    for row in [*rows, overall]:
+    for row in [*rows, overall] if overall else rows:
         if row is overall:
             print("-" * 89)
         low, high = (100 * v for v in row["reach_interval"])

@@ -1,0 +1,77 @@
+"""A legged robot with a damaged leg or side (docs/perturbations.md, "Legged robots").
+
+Legs are found from the URDF: leg ``k`` is the chain of actuated joints from the robot's
+``k``-th foot link up to the body; its *knee* is the actuated joint nearest the foot (the
+hexapod's tibia joint, the A1's calf joint). A leg is on the left when its foot stands at
+``y > 0`` in the body frame (REP 103) when the episode starts.
+
+* ``leg_lost``: the leg's servos give no torque; the leg hangs limp and drags.
+* ``knee_locked``: the knee's target is held at the angle the knee has at the episode's
+  start, whatever the gait asks (its servo holds it with its usual torque).
+* ``weak_leg`` / ``weak_side``: the servos of the leg / of every leg on the side give the
+  drawn share of their maximal torque.
+"""
+
+from __future__ import annotations
+
+import math
+
+from sim_bridge.damage import SIDES, DamageDraw, DamageSpec
+from sim_bridge.legged.physics import LeggedSim
+from sim_bridge.quiet_pybullet import p
+
+
+def leg_columns(sim: LeggedSim) -> list[list[int]]:
+    """Per foot link, in the settings' order: the joint columns of its leg, knee first.
+
+    A column indexes ``sim.joints`` (the command order). PyBullet numbers a link like the
+    joint that carries it, so walking the parents from the foot meets the leg's joints.
+    """
+    column = {j: k for k, j in enumerate(sim.joints)}
+    legs = []
+    for foot in sim.feet:
+        leg, link = [], foot
+        while link >= 0:
+            if link in column:
+                leg.append(column[link])
+            link = p.getJointInfo(sim.robot, link, physicsClientId=sim.client)[16]
+        legs.append(leg)
+    return legs
+
+
+def leg_sides(sim: LeggedSim) -> list[str]:
+    """Per foot link: ``left`` or ``right`` of the body now (its y in the body frame)."""
+    c = sim.client
+    (bx, by, _), orn = p.getBasePositionAndOrientation(sim.robot, physicsClientId=c)
+    yaw = p.getEulerFromQuaternion(orn)[2]
+    sides = []
+    for foot in sim.feet:
+        fx, fy, _ = p.getLinkState(sim.robot, foot, physicsClientId=c)[0]
+        y = -math.sin(yaw) * (fx - bx) + math.cos(yaw) * (fy - by)
+        sides.append(SIDES[0] if y > 0.0 else SIDES[1])
+    return sides
+
+
+def apply_damage(sim: LeggedSim, row: dict, torques: list[float]) -> None:
+    """Set ``sim.torques`` (from the nominal ``torques``) and ``sim.locked`` for ``row``.
+
+    ``row``: a :meth:`~sim_bridge.damage.DamageDraw.row` dict. The caller puts both back.
+    """
+    legs = leg_columns(sim)
+    names = tuple(sim.settings.foot_links)
+    draw = DamageDraw(
+        DamageSpec(row["kind"], row["part"]),
+        *([row[k]] for k in ("part_u", "level", "sign")),
+    )
+    kind = row["kind"]
+    if kind == "weak_side":
+        side = SIDES[draw.part(0, SIDES)]
+        columns = [c for leg, s in zip(legs, leg_sides(sim), strict=True) if s == side for c in leg]
+    else:
+        columns = legs[draw.part(0, names)]
+    if kind == "knee_locked":
+        angles = sim.joint_states()[0]
+        sim.locked = {columns[0]: float(angles[columns[0]])}
+        return
+    share = 0.0 if kind == "leg_lost" else row["level"]
+    sim.torques = [t * share if k in columns else t for k, t in enumerate(torques)]
