@@ -14,7 +14,8 @@ kind                      family    part               level
 ``stuck_steering``        4WS       wheel (fl ... rr)  deg, the stuck angle's size (sign drawn)
 ``slow_wheel``            4WS       wheel              share of its commanded speed it turns at
 ``slipping_wheel``        4WS       wheel              largest share of traction lost per cycle
-``leg_lost``              legged    leg (index)        none: the leg's servos go limp
+``leg_lost``              legged    leg (index)        none: the leg's links are gone
+``leg_limp``              legged    leg                none: the leg's servos go limp
 ``knee_locked``           legged    leg                none: the knee held at its start angle
 ``weak_leg``              legged    leg                share of the leg's servo torque left
 ``weak_side``             legged    left / right       share of the side's servo torque left
@@ -42,6 +43,7 @@ KINDS = {
     "slow_wheel": ("four_ws", "wheel", "speed_factor", (0.0, 1.0)),
     "slipping_wheel": ("four_ws", "wheel", "slip", (0.0, 1.0)),
     "leg_lost": ("legged", "leg", None, (0.0, 0.0)),
+    "leg_limp": ("legged", "leg", None, (0.0, 0.0)),
     "knee_locked": ("legged", "leg", None, (0.0, 0.0)),
     "weak_leg": ("legged", "leg", "strength", (0.0, 1.0)),
     "weak_side": ("legged", "side", "strength", (0.0, 1.0)),
@@ -211,7 +213,8 @@ def describe(row: dict, names: tuple[str, ...]) -> tuple[str, str]:
         "stuck_steering": f"steering stuck at {level * row['sign']:+.1f} deg",
         "slow_wheel": f"turning at {level:.2f} of its speed",
         "slipping_wheel": f"losing up to {level:.2f} of its traction",
-        "leg_lost": "limp",
+        "leg_lost": "lost",
+        "leg_limp": "limp",
         "knee_locked": "knee locked",
         "weak_leg": f"servos at {level:.2f} torque",
         "weak_side": f"servos at {level:.2f} torque",

@@ -5,7 +5,9 @@ Legs are found from the URDF: leg ``k`` is the chain of actuated joints from the
 hexapod's tibia joint, the A1's calf joint). A leg is on the left when its foot stands at
 ``y > 0`` in the body frame (REP 103) when the episode starts.
 
-* ``leg_lost``: the leg's servos give no torque; the leg hangs limp and drags.
+* ``leg_lost``: the leg's links are gone: they collide with nothing (ground, walls, the
+  robot, the laser's rays) and keep 0.1 % of their mass (PyBullet needs a mass).
+* ``leg_limp``: the leg's servos give no torque; the leg hangs limp and drags.
 * ``knee_locked``: the knee's target is held at the angle the knee has at the episode's
   start, whatever the gait asks (its servo holds it with its usual torque).
 * ``weak_leg`` / ``weak_side``: the servos of the leg / of every leg on the side give the
@@ -15,28 +17,32 @@ hexapod's tibia joint, the A1's calf joint). A leg is on the left when its foot 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 from sim_bridge.damage import SIDES, DamageDraw, DamageSpec
-from sim_bridge.legged.physics import LeggedSim
+from sim_bridge.legged.physics import GROUND_GROUP, ROBOT_GROUP, WALL_GROUP, LeggedSim
 from sim_bridge.quiet_pybullet import p
 
 
-def leg_columns(sim: LeggedSim) -> list[list[int]]:
-    """Per foot link, in the settings' order: the joint columns of its leg, knee first.
+def leg_links(sim: LeggedSim) -> list[list[int]]:
+    """Per foot link, in the settings' order: the links of its leg, foot first.
 
-    A column indexes ``sim.joints`` (the command order). PyBullet numbers a link like the
-    joint that carries it, so walking the parents from the foot meets the leg's joints.
+    PyBullet numbers a link like the joint that carries it; the walk ends at the body (-1).
     """
-    column = {j: k for k, j in enumerate(sim.joints)}
     legs = []
     for foot in sim.feet:
         leg, link = [], foot
         while link >= 0:
-            if link in column:
-                leg.append(column[link])
+            leg.append(link)
             link = p.getJointInfo(sim.robot, link, physicsClientId=sim.client)[16]
         legs.append(leg)
     return legs
+
+
+def leg_columns(sim: LeggedSim) -> list[list[int]]:
+    """Per foot link: the joint columns of its leg (into ``sim.joints``), knee first."""
+    column = {j: k for k, j in enumerate(sim.joints)}
+    return [[column[link] for link in leg if link in column] for leg in leg_links(sim)]
 
 
 def leg_sides(sim: LeggedSim) -> list[str]:
@@ -52,10 +58,28 @@ def leg_sides(sim: LeggedSim) -> list[str]:
     return sides
 
 
-def apply_damage(sim: LeggedSim, row: dict, torques: list[float]) -> None:
+def _remove(sim: LeggedSim, links: list[int]) -> Callable[[], None]:
+    """Take ``links`` out of the world; return what puts them back."""
+    c, robot = sim.client, sim.robot
+    masses = [p.getDynamicsInfo(robot, k, physicsClientId=c)[0] for k in links]
+    for k, mass in zip(links, masses, strict=True):
+        p.setCollisionFilterGroupMask(robot, k, 0, 0, physicsClientId=c)
+        p.changeDynamics(robot, k, mass=mass * 1e-3, physicsClientId=c)
+
+    def restore() -> None:
+        mask = WALL_GROUP | ROBOT_GROUP | GROUND_GROUP  # as LeggedSim loads the robot
+        for k, mass in zip(links, masses, strict=True):
+            p.setCollisionFilterGroupMask(robot, k, ROBOT_GROUP, mask, physicsClientId=c)
+            p.changeDynamics(robot, k, mass=mass, physicsClientId=c)
+
+    return restore
+
+
+def apply_damage(sim: LeggedSim, row: dict, torques: list[float]) -> Callable[[], None] | None:
     """Set ``sim.torques`` (from the nominal ``torques``) and ``sim.locked`` for ``row``.
 
-    ``row``: a :meth:`~sim_bridge.damage.DamageDraw.row` dict. The caller puts both back.
+    ``row``: a :meth:`~sim_bridge.damage.DamageDraw.row` dict. The caller puts the torques
+    and locks back; a lost leg's links come back through the returned callable.
     """
     legs = leg_columns(sim)
     names = tuple(sim.settings.foot_links)
@@ -64,6 +88,8 @@ def apply_damage(sim: LeggedSim, row: dict, torques: list[float]) -> None:
         *([row[k]] for k in ("part_u", "level", "sign")),
     )
     kind = row["kind"]
+    if kind == "leg_lost":
+        return _remove(sim, leg_links(sim)[draw.part(0, names)])
     if kind == "weak_side":
         side = SIDES[draw.part(0, SIDES)]
         columns = [c for leg, s in zip(legs, leg_sides(sim), strict=True) if s == side for c in leg]
@@ -72,6 +98,7 @@ def apply_damage(sim: LeggedSim, row: dict, torques: list[float]) -> None:
     if kind == "knee_locked":
         angles = sim.joint_states()[0]
         sim.locked = {columns[0]: float(angles[columns[0]])}
-        return
-    share = 0.0 if kind == "leg_lost" else row["level"]
+        return None
+    share = 0.0 if kind == "leg_limp" else row["level"]
     sim.torques = [t * share if k in columns else t for k, t in enumerate(torques)]
+    return None

@@ -43,6 +43,7 @@ def perturbed_sim(sim: LeggedSim, world: dict | None) -> Iterator[None]:
     mass, inertia = info[0], info[2]  # kg and kg m^2 (principal axes) of the root link
     torques, settings = list(sim.torques), sim.settings
     mass_factor = world["body_mass"] + world["payload"]
+    restore = None
     try:
         if world["friction"] != 1.0:
             # Contact friction is the product of both bodies' coefficients: scaling the
@@ -62,7 +63,7 @@ def perturbed_sim(sim: LeggedSim, world: dict | None) -> Iterator[None]:
         if world["servo_strength"] != 1.0:
             sim.torques = [t * world["servo_strength"] for t in torques]
         if world.get("damage"):  # after the strength: a weak leg is weaker still
-            apply_damage(sim, world["damage"], sim.torques)
+            restore = apply_damage(sim, world["damage"], sim.torques)
         if world["servo_speed"] != 1.0:
             servo = dataclasses.replace(
                 settings.servo, max_velocity=settings.servo.max_velocity * world["servo_speed"]
@@ -77,6 +78,8 @@ def perturbed_sim(sim: LeggedSim, world: dict | None) -> Iterator[None]:
                 sim.robot, -1, mass=mass, localInertiaDiagonal=inertia, physicsClientId=c
             )
         sim.torques, sim.settings, sim.locked = torques, settings, {}
+        if restore is not None:
+            restore()
 
 
 def perturbed_ranges(ranges: np.ndarray, world: dict | None, cycle: int) -> np.ndarray:
