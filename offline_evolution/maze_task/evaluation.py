@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from offline_evolution.maze_task.base import MazeTaskBase
-from offline_evolution.maze_task.perturbation import NONE, PerturbationSet
+from offline_evolution.maze_task.perturbation import NONE, PerturbationSet, check_damage
 from offline_evolution.mazes.paths import solve
 from sim_bridge.damage import describe, part_names
 
@@ -201,12 +201,7 @@ def evaluate_suite(
     if perturbation is not NONE:
         if not takes:
             raise ValueError("this robot's maze task takes no perturbations")
-        damage = perturbation.damage
-        if damage is not None and f"damage:{damage.kind}" not in takes:
-            raise ValueError(
-                f"this robot's simulation cannot apply damage {damage.kind} "
-                f"(it applies: {', '.join(q for q in takes if q.startswith('damage:')) or 'none'})"
-            )
+        check_damage(task, perturbation)
         world = perturbation.draw(np.random.default_rng([seed, 1]), len(starts))
         starts = world.shift_starts(starts, task.mazes, task.footprint_radius)
     result = task.evaluate([network], controller, starts, record=True, world=world)

@@ -62,7 +62,9 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
     """
 
     #: What of a perturbation set its simulation applies (docs/design.md section 21).
-    perturbations_applied = PYBULLET_LEGGED + LEGGED_DAMAGE
+    perturbations_applied = PYBULLET_LEGGED
+    #: The kinds of damage it applies (docs/perturbations.md).
+    damage_applied = LEGGED_DAMAGE
 
     def __init__(
         self,

@@ -2,7 +2,7 @@
 
 The sets live in :mod:`sim_bridge.perturbation`, one layer down, so that the simulation
 bridge and ``evorbc-sim`` load the same files; this module keeps the names the search and
-its users import.
+its users import, and checks a set's damage against a maze task (:func:`check_damage`).
 """
 
 from sim_bridge.perturbation import (
@@ -16,6 +16,21 @@ from sim_bridge.perturbation import (
     perturbation_dir,
 )
 
+
+def check_damage(task, perturbation: PerturbationSet) -> None:
+    """Refuse a set whose damage ``task``'s simulation cannot apply (its ``damage_applied``).
+
+    Raises:
+        ValueError: naming the damage and the kinds the simulation applies.
+    """
+    damage, takes = perturbation.damage, tuple(getattr(task, "damage_applied", ()))
+    if damage is not None and damage.kind not in takes:
+        raise ValueError(
+            f"this robot's simulation cannot apply damage {damage.kind} "
+            f"(it applies: {', '.join(takes) or 'no damage'})"
+        )
+
+
 __all__ = [
     "KINEMATIC",
     "NONE",
@@ -23,6 +38,7 @@ __all__ = [
     "QUANTITIES",
     "PerturbationSet",
     "WorldDraw",
+    "check_damage",
     "load_perturbations",
     "perturbation_dir",
 ]

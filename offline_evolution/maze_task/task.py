@@ -150,8 +150,9 @@ class MazeTask(MazeTaskBase):
 
             robot = make_robot(robot)
         self.robot = robot
-        if isinstance(robot.limits, MotionLimits):  # 4WS wheels can be damaged one by one
-            self.perturbations_applied = KINEMATIC + FOUR_WS_DAMAGE
+        #: The kinds of damage its simulation applies (docs/perturbations.md): a 4WS
+        #: robot's wheels one by one; a differential drive's none.
+        self.damage_applied = FOUR_WS_DAMAGE if isinstance(robot.limits, MotionLimits) else ()
         super().__init__(settings, robot.control_period, robot.footprint_radius, robot.name)
         self.sensors = compile_layout(self.layout, robot.control_period)
         # Walls a ray or the footprint can touch from a cell: sensor reach plus a step and

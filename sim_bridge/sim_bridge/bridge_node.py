@@ -207,7 +207,7 @@ class SimBridgeNode(Node):
             raise StartupError(f"parameter perturb: {e}") from None
         draw = perturbation.draw(np.random.default_rng([seed, 1]), 1)
         applied = self.robot.perturb(draw)
-        if perturbation.damage is not None and f"damage:{perturbation.damage.kind}" not in applied:
+        if perturbation.damage is not None and perturbation.damage.kind not in applied:
             raise StartupError(
                 f"parameter perturb {name}: this robot's simulation cannot apply damage "
                 f"{perturbation.damage.kind}"

@@ -66,7 +66,7 @@ class KinematicBridge:
         if draw.damage is not None and draw.damage.spec.family == "four_ws":
             self.world.damage = draw.kernel_arrays(1.0)[0, 4:7].copy()
             self.world.damage_key = int(draw.keys[0])
-            applied.append(f"damage:{draw.damage.spec.kind}")
+            applied.append(draw.damage.spec.kind)
         return tuple(applied)
 
     def body_pose(self) -> tuple[tuple, tuple]:

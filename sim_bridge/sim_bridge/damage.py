@@ -50,9 +50,9 @@ KINDS = {
 }
 #: Codes of the 4WS kinds in the compiled kernel (0: intact).
 FOUR_WS_CODES = {"stuck_steering": 1, "slow_wheel": 2, "slipping_wheel": 3}
-#: What each family's simulation applies (a task's ``perturbations_applied``).
-FOUR_WS_DAMAGE = tuple(f"damage:{k}" for k, v in KINDS.items() if v[0] == "four_ws")
-LEGGED_DAMAGE = tuple(f"damage:{k}" for k, v in KINDS.items() if v[0] == "legged")
+#: The kinds each family's simulation applies (a task's ``damage_applied``).
+FOUR_WS_DAMAGE = tuple(k for k, v in KINDS.items() if v[0] == "four_ws")
+LEGGED_DAMAGE = tuple(k for k, v in KINDS.items() if v[0] == "legged")
 
 
 def number_pair(v) -> bool:

@@ -136,9 +136,8 @@ class PerturbationSet:
         return {f.name: getattr(self, f.name) for f in fields(self) if f.name in QUANTITIES}
 
     def perturbed(self) -> tuple[str, ...]:
-        """The quantities whose range is not just the identity value, then ``damage:KIND``."""
-        out = tuple(k for k, (lo, hi) in self.ranges().items() if not lo == hi == QUANTITIES[k][0])
-        return out + ((f"damage:{self.damage.kind}",) if self.damage else ())
+        """The quantities whose range is not just the identity value (damage aside)."""
+        return tuple(k for k, (lo, hi) in self.ranges().items() if not lo == hi == QUANTITIES[k][0])
 
     def as_dict(self) -> dict:
         """Plain-data form (reports); ``damage`` only when the set has one."""

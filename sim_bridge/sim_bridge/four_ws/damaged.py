@@ -10,12 +10,16 @@ body motion is derived from the wheels:
    body frame at the step's start), the inverse of the exact arc.
 2. Each wheel ``i`` at ``p_i`` (body frame, m) would move its contact point by
    ``V_i = (ux - dtheta p_iy, uy + dtheta p_ix)``; it rolls by ``r_i = V_i . d_i`` along its
-   direction ``d_i = (cos a_i, sin a_i)``.
-3. The damaged wheel ``w`` moves its contact point by ``T_w = f r_w d'_w`` instead:
-   ``stuck_steering`` rolls the same distance along its stuck angle (``d'_w``),
-   ``slow_wheel`` turns at the factor ``f`` of its speed, ``slipping_wheel`` loses a share
-   ``slip x u`` of its traction each cycle (``f = 1 - slip x u``, ``u`` uniform in [0, 1)
-   from the episode's key and the cycle, :func:`~sim_bridge.hashing.hash_uniform`).
+   direction ``d_i = (cos a_i, sin a_i)``
+   and ``s_i = V_i . n_i`` across it (``n_i = (-sin a_i, cos a_i)``: the sideways slip the
+   intact model tolerates, up to 10 deg).
+3. The damaged wheel ``w`` moves its contact point by ``T_w = f r_w d'_w + s_w n'_w``
+   instead: ``stuck_steering`` moves the same along and across its stuck angle
+   (``d'_w``, ``n'_w``), ``slow_wheel`` turns at the factor ``f`` of its speed,
+   ``slipping_wheel`` loses a share ``slip x u`` of its traction each cycle
+   (``f = 1 - slip x u``, ``u`` uniform in [0, 1) from the episode's key and the cycle,
+   :func:`~sim_bridge.hashing.hash_uniform`). An undamaged wheel (``f = 1``, its own
+   angle) gives ``T_w = V_w``.
 4. The body's twist is the least-squares rigid-body fit of the four contact-point
    motions, rolling and sideways slip weighted alike: minimise
    ``sum_i |(ux' - dtheta' p_iy, uy' + dtheta' p_ix) - T_i|^2`` with ``T_i = V_i`` for the
@@ -108,16 +112,18 @@ def damaged_body_motion(angles, distance, lim, kind, wheel, level, traction):
     vx = ux - dtheta * py
     vy = uy + dtheta * px
     a = angles[wheel]
-    roll = vx * math.cos(a) + vy * math.sin(a)  # m the wheel rolls along its direction
-    factor = 1.0
+    # Its motion along its direction (rolling, m) and across it (the intact model's
+    # tolerated slip, m), in the wheel's frame.
+    roll = vx * math.cos(a) + vy * math.sin(a)
+    across = -vx * math.sin(a) + vy * math.cos(a)
     if kind == STUCK_STEERING:
         a = level
     elif kind == SLOW_WHEEL:
-        factor = level
+        roll *= level
     elif kind == SLIPPING_WHEEL:
-        factor = 1.0 - level * traction
-    ex = factor * roll * math.cos(a) - vx
-    ey = factor * roll * math.sin(a) - vy
+        roll *= 1.0 - level * traction
+    ex = roll * math.cos(a) - across * math.sin(a) - vx
+    ey = roll * math.sin(a) + across * math.cos(a) - vy
     ux += 0.25 * ex
     uy += 0.25 * ey
     dtheta += (px * ey - py * ex) / (4.0 * (px * px + py * py))

@@ -127,7 +127,7 @@ class TrajectoryBridge:
         self._perturbed.enter_context(perturbed_sim(self.world.sim, draw.row(0)))
         applied = ("friction", "body_mass", "payload", "servo_strength", "servo_speed")
         if draw.damage is not None and draw.damage.spec.family == "legged":
-            applied += (f"damage:{draw.damage.spec.kind}",)
+            applied += (draw.damage.spec.kind,)
         return applied
 
     def twist(self) -> tuple[float, float]:

@@ -6,7 +6,7 @@ hexapod's tibia joint, the A1's calf joint). A leg is on the left when its foot 
 ``y > 0`` in the body frame (REP 103) when the episode starts.
 
 * ``leg_lost``: the leg's links are gone: they collide with nothing (ground, walls, the
-  robot, the laser's rays) and keep 0.1 % of their mass (PyBullet needs a mass).
+  robot) and keep 0.1 % of their mass and inertia (PyBullet needs a mass).
 * ``leg_limp``: the leg's servos give no torque; the leg hangs limp and drags.
 * ``knee_locked``: the knee's target is held at the angle the knee has at the episode's
   start, whatever the gait asks (its servo holds it with its usual torque).
@@ -20,7 +20,7 @@ import math
 from collections.abc import Callable
 
 from sim_bridge.damage import SIDES, DamageDraw, DamageSpec
-from sim_bridge.legged.physics import GROUND_GROUP, ROBOT_GROUP, WALL_GROUP, LeggedSim
+from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.quiet_pybullet import p
 
 
@@ -59,18 +59,35 @@ def leg_sides(sim: LeggedSim) -> list[str]:
 
 
 def _remove(sim: LeggedSim, links: list[int]) -> Callable[[], None]:
-    """Take ``links`` out of the world; return what puts them back."""
+    """Take ``links`` out of the world; return what puts them back, bit for bit.
+
+    Collision pairs are switched off (the ground, the walls, the robot's other links),
+    not the links' collision groups: taking a link out of the broadphase and back reorders
+    its pairs, so later episodes would differ. The mass and inertia shrink together
+    (PyBullet recomputes the inertia from the shape when given the mass alone).
+    """
     c, robot = sim.client, sim.robot
-    masses = [p.getDynamicsInfo(robot, k, physicsClientId=c)[0] for k in links]
-    for k, mass in zip(links, masses, strict=True):
-        p.setCollisionFilterGroupMask(robot, k, 0, 0, physicsClientId=c)
-        p.changeDynamics(robot, k, mass=mass * 1e-3, physicsClientId=c)
+    others = [(robot, k) for k in range(-1, p.getNumJoints(robot, physicsClientId=c))]
+    others = [(b, k) for b, k in others if k not in links]
+    others += [(body, -1) for body in (sim.ground, *sim.walls)]
+    info = [p.getDynamicsInfo(robot, k, physicsClientId=c) for k in links]
+
+    def switch(enable: int) -> None:
+        for k in links:
+            for body, other in others:
+                p.setCollisionFilterPair(robot, body, k, other, enable, physicsClientId=c)
+
+    switch(0)
+    for k, i in zip(links, info, strict=True):
+        p.changeDynamics(
+            robot, k, mass=i[0] * 1e-3, localInertiaDiagonal=[v * 1e-3 for v in i[2]],
+            physicsClientId=c,
+        )  # fmt: skip
 
     def restore() -> None:
-        mask = WALL_GROUP | ROBOT_GROUP | GROUND_GROUP  # as LeggedSim loads the robot
-        for k, mass in zip(links, masses, strict=True):
-            p.setCollisionFilterGroupMask(robot, k, ROBOT_GROUP, mask, physicsClientId=c)
-            p.changeDynamics(robot, k, mass=mass, physicsClientId=c)
+        switch(1)
+        for k, i in zip(links, info, strict=True):
+            p.changeDynamics(robot, k, mass=i[0], localInertiaDiagonal=i[2], physicsClientId=c)
 
     return restore
 
