@@ -72,8 +72,9 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--perturb",
         default=EvaluateRun.perturb,
-        metavar="none|realistic|FILE.yaml",
-        help="perturbation set: a shipped one (config/perturbations/) or a file",
+        metavar="none|NAME|FILE.yaml",
+        help="perturbation or damage set: a shipped one (config/perturbations/: realistic, "
+        "4ws-stuck-steering, hexapod-leg-lost, ...; docs/perturbations.md) or a file",
     )
     add_task(p, "the arbitrator's; its episode time and sensors")
     p.add_argument("--plot", metavar="FILE.png", help="picture of the suite with every path")
