@@ -38,6 +38,7 @@ class GraphRun:
         arbitrator=None,
         repertoire="",
         robot="4ws-5",
+        bridge=None,
     ):
         self.env = graph_env(domain)
         self.result = tmp_path / f"{maze}-{mode}.json"
@@ -66,6 +67,7 @@ class GraphRun:
                 "mode": mode,
                 "result_file": str(self.result),
                 "episode_time": episode_time,
+                **(bridge or {}),  # more bridge parameters (a perturbation set, its seed)
             },
         )
 

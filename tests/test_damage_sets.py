@@ -354,3 +354,35 @@ def test_a_lost_legs_links_touch_nothing_while_it_is_lost():
             sim.run(np.tile(sim.settings.gait.standing_pose(), (50, 1)))
             touching = {pt[3] for pt in p.getContactPoints(sim.robot, physicsClientId=sim.client)}
             assert not touching & set(links)
+
+
+# -- the ROS graph -----------------------------------------------------------------------
+
+
+def test_the_lockstep_graph_drives_a_damaged_robot_as_the_offline_episode(tmp_path):
+    # The bridge draws one world from default_rng([seed, 1]) and steps the same damaged
+    # model as the kernel: the shipped controller with a slipping wheel, bit for bit.
+    from graph_helpers import GraphRun, assert_same_choices
+
+    from evorbc_ros.defaults import default_arbitrator
+    from offline_evolution.maze_task.task import MazeTask
+
+    path = default_arbitrator()
+    arb = ArbitratorFile.load(path)
+    sensors = MazeTaskSettings.from_dict(arb.evolution["task"], str(path)).sensors
+    task = MazeTask(MazeTaskSettings(("gaps",), 25.0, 1, sensors), arb.robot)
+    controller = task.controller("evorbc", Repertoire.load(default_repertoire()), arb.mapping)
+    starts = task.nominal_starts()
+    slip = load_perturbations("4ws-slipping-wheel")
+    world = slip.draw(np.random.default_rng([4, 1]), 1)
+    result = task.evaluate([arb.network], controller, starts, record=True, world=world)
+    intact = task.evaluate([arb.network], controller, starts, record=True)
+    run = GraphRun(tmp_path, 183, "gaps", episode_time=25.0, arbitrator=path,
+                   bridge={"perturb": "4ws-slipping-wheel", "seed": 4})  # fmt: skip
+    got = run.finish(timeout=120)
+    cycles = assert_same_choices(run.recorded_choices(), result)
+    trajectory = np.array(got["trajectory"])
+    np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
+    assert not np.array_equal(result.pose[0, :cycles], intact.pose[0, :cycles])
+    log = (tmp_path / "gaps-lockstep.log").read_text()
+    assert "perturbation set 4ws-slipping-wheel (seed 4)" in log and "slipping_wheel: " in log
