@@ -386,3 +386,32 @@ def test_the_lockstep_graph_drives_a_damaged_robot_as_the_offline_episode(tmp_pa
     assert not np.array_equal(result.pose[0, :cycles], intact.pose[0, :cycles])
     log = (tmp_path / "gaps-lockstep.log").read_text()
     assert "perturbation set 4ws-slipping-wheel (seed 4)" in log and "slipping_wheel: " in log
+
+
+# -- training ----------------------------------------------------------------------------
+
+
+def test_training_runs_in_damaged_worlds_and_refuses_a_damage_the_robot_cannot_take():
+    from conftest import SMALL_TASK
+
+    from offline_evolution.maze_task.task import MazeTask
+
+    def task(perturb):
+        training = {"generated": 2, "starts": 1, "pool": 0, "maze_seed": 5, "perturb": perturb}
+        data = {**SMALL_TASK, "training": training}
+        return MazeTask(MazeTaskSettings.from_dict(data, "t.yaml"), "4ws-5")
+
+    with pytest.raises(ConfigError) as e:
+        task("hexapod-leg-lost").start_training("4ws-5", 1, source="t.yaml")
+    assert str(e.value) == (
+        "t.yaml: training: perturb hexapod-leg-lost: 4ws-5: this robot's simulation cannot "
+        "apply damage leg_lost (it applies: stuck_steering, slow_wheel, slipping_wheel)"
+    )
+    stuck = task("4ws-stuck-steering")
+    stuck.start_training("4ws-5", 1, source="t.yaml")
+    # A generation's worlds: drawn from the run's generator, the same again for the same seed.
+    starts, world = stuck.generation_episodes(np.random.default_rng(9))
+    again, world2 = stuck.generation_episodes(np.random.default_rng(9))
+    np.testing.assert_array_equal(starts, again)
+    np.testing.assert_array_equal(world.kernel_arrays(1.0), world2.kernel_arrays(1.0))
+    assert (world.kernel_arrays(1.0)[:, 4] == FOUR_WS_CODES["stuck_steering"]).all()
