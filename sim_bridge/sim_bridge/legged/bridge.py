@@ -123,8 +123,15 @@ class TrajectoryBridge:
         (:func:`~sim_bridge.legged.perturbed.perturbed_sim`, left in force until the
         world closes); the rest of a set is the offline episodes' alone.
         """
-        self._perturbed = contextlib.ExitStack()
-        self._perturbed.enter_context(perturbed_sim(self.world.sim, draw.row(0)))
+        stack = contextlib.ExitStack()
+        stack.enter_context(perturbed_sim(self.world.sim, draw.row(0)))
+        close = self.world.close
+
+        def put_back_and_close() -> None:
+            stack.close()  # while PyBullet is still connected
+            close()
+
+        self.world.close = put_back_and_close
         applied = ("friction", "body_mass", "payload", "servo_strength", "servo_speed")
         if draw.damage is not None and draw.damage.spec.family == "legged":
             applied += (draw.damage.spec.kind,)

@@ -6,7 +6,8 @@ hexapod's tibia joint, the A1's calf joint). A leg is on the left when its foot 
 ``y > 0`` in the body frame (REP 103) when the episode starts.
 
 * ``leg_lost``: the leg's links are gone: they collide with nothing (ground, walls, the
-  robot) and keep 0.1 % of their mass and inertia (PyBullet needs a mass).
+  robot), keep 0.1 % of their mass and inertia (PyBullet needs a mass) and their servos
+  give no torque.
 * ``leg_limp``: the leg's servos give no torque; the leg hangs limp and drags.
 * ``knee_locked``: the knee's target is held at the angle the knee has at the episode's
   start, whatever the gait asks (its servo holds it with its usual torque).
@@ -106,7 +107,11 @@ def apply_damage(sim: LeggedSim, row: dict, torques: list[float]) -> Callable[[]
     )
     kind = row["kind"]
     if kind == "leg_lost":
-        return _remove(sim, leg_links(sim)[draw.part(0, names)])
+        # Its servos stop too: driving links of 0.1 % of their mass at full torque shakes
+        # the solver.
+        leg = draw.part(0, names)
+        sim.torques = [0.0 if k in legs[leg] else t for k, t in enumerate(torques)]
+        return _remove(sim, leg_links(sim)[leg])
     if kind == "weak_side":
         side = SIDES[draw.part(0, SIDES)]
         columns = [c for leg, s in zip(legs, leg_sides(sim), strict=True) if s == side for c in leg]
