@@ -135,6 +135,11 @@ def test_the_cli_refuses_a_bad_set_and_a_damage_the_robot_cannot_take(tmp_path, 
         check_perturb("hexapod-leg-lost", "4ws-5")
     with pytest.raises(ConfigError, match="damage stuck_steering is for four_ws robots"):
         check_perturb("4ws-stuck-steering", "hexapod")
+    path.write_text(yaml.safe_dump({"damage": {"kind": "knee_locked", "part": 5}}))
+    capsys.readouterr()
+    assert main(["evaluate", "--robot", "a1", "--perturb", str(path), "--starts", "1"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "damage.part '5': this robot's parts are FL_toe" in err
     check_perturb("4ws-stuck-steering", "4ws-5")
     check_perturb("a1-knee-locked", "a1")
 

@@ -206,7 +206,10 @@ class SimBridgeNode(Node):
         except ConfigError as e:
             raise StartupError(f"parameter perturb: {e}") from None
         draw = perturbation.draw(np.random.default_rng([seed, 1]), 1)
-        applied = self.robot.perturb(draw)
+        try:
+            applied = self.robot.perturb(draw)
+        except ConfigError as e:  # a fixed leg this robot has not
+            raise StartupError(f"parameter perturb {name}: {e}") from None
         if perturbation.damage is not None and perturbation.damage.kind not in applied:
             raise StartupError(
                 f"parameter perturb {name}: this robot's simulation cannot apply damage "
