@@ -69,7 +69,7 @@ class GraphRun:
                 "mode": mode,
                 "result_file": str(self.result),
                 "episode_time": episode_time,
-                **(bridge or {}),
+                **(bridge or {}),  # more bridge parameters (a perturbation set, its seed)
             },
         )
 

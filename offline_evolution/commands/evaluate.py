@@ -72,8 +72,9 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--perturb",
         default=EvaluateRun.perturb,
-        metavar="none|realistic|FILE.yaml",
-        help="perturbation set: a shipped one (config/perturbations/) or a file",
+        metavar="none|NAME|FILE.yaml",
+        help="perturbation or damage set: a shipped one (config/perturbations/: realistic, "
+        "4ws-stuck-steering, hexapod-leg-lost, ...; docs/perturbations.md) or a file",
     )
     add_task(p, "the arbitrator's; its episode time and sensors")
     p.add_argument("--plot", metavar="FILE.png", help="picture of the suite with every path")
@@ -97,15 +98,18 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
         f"{done.perturbation}"
     )
     _print_table(report["per_maze"], report["overall"])
+    if report.get("per_damage"):
+        print(f"by damaged part ({report['perturbation']['damage']['kind']}):")
+        _print_table(report["per_damage"], None)
     return 0
 
 
-def _print_table(rows: list[dict], overall: dict) -> None:
+def _print_table(rows: list[dict], overall: dict | None) -> None:
     print(
         f"{'maze':<14} {'episodes':>8} {'reached':>7} {'reach %':>7} {'95 % interval':>13} "
         f"{'mean fitness':>12} {'stalls':>6} {'collisions':>10} {'falls':>5}"
     )
-    for row in [*rows, overall]:
+    for row in [*rows, overall] if overall else rows:
         if row is overall:
             print("-" * 89)
         low, high = (100 * v for v in row["reach_interval"])

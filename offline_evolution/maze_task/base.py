@@ -376,6 +376,14 @@ class MazeTaskBase(abc.ABC):
                     f"{source}: training: perturb {training.perturbation.name}: {robot}'s "
                     "simulation takes no perturbed worlds (use none)"
                 )
+            from offline_evolution.maze_task.perturbation import check_damage
+
+            try:
+                check_damage(self, training.perturbation)
+            except ValueError as e:
+                raise ConfigError(
+                    f"{source}: training: perturb {training.perturbation.name}: {robot}: {e}"
+                ) from None
             self.training = training
 
     def use_mazes(self, generated: list[Maze]) -> None:

@@ -21,8 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from offline_evolution.maze_task.base import MazeTaskBase
-from offline_evolution.maze_task.perturbation import NONE, PerturbationSet
+from offline_evolution.maze_task.perturbation import NONE, PerturbationSet, check_damage
 from offline_evolution.mazes.paths import solve
+from sim_bridge.damage import describe, part_names
 
 #: s without progress along the maze that counts as a stall (capped at the episode time).
 STALL_TIME = 30.0
@@ -50,9 +51,11 @@ class SuiteEpisode:
     collided: bool
     contact_share: float  # share of the episode's poses touching a wall
     fell: bool
+    damage: str = ""  # the episode's damage (docs/perturbations.md), "" when intact
+    damaged_part: str = ""  # the wheel, leg or side it hit
 
     def as_dict(self) -> dict:
-        """Plain-data form (JSON)."""
+        """Plain-data form (JSON); ``damage`` only for a damaged episode."""
         return {
             "maze": self.maze,
             "start": [round(v, 6) for v in self.start],
@@ -65,6 +68,7 @@ class SuiteEpisode:
             "collided": self.collided,
             "contact_share": round(self.contact_share, 4),
             "fell": self.fell,
+            **({"damage": self.damage} if self.damage else {}),
         }
 
 
@@ -86,6 +90,11 @@ class SuiteResult:
     def overall(self) -> dict:
         """Figures over every episode."""
         return summarise(self.episodes, "all")
+
+    def per_damage(self) -> list[dict]:
+        """Figures per damaged part (wheel, leg or side), in name order; [] when intact."""
+        parts = sorted({e.damaged_part for e in self.episodes if e.damaged_part})
+        return [summarise([e for e in self.episodes if e.damaged_part == p], p) for p in parts]
 
 
 def reach_interval(reached: int, n: int) -> tuple[float, float]:
@@ -135,6 +144,15 @@ def stalled(distance: np.ndarray, window: int, step: float) -> bool:
     return bool(np.any(best[:-window] - best[window:] < step))
 
 
+def _damage(world, k: int, task) -> dict:
+    """Start row ``k``'s ``damage`` and ``damaged_part`` fields (none when intact)."""
+    if world is None or world.damage is None:
+        return {}
+    row = world.damage.row(k)
+    part, text = describe(row, part_names(row["kind"], tuple(getattr(task, "damage_legs", ()))))
+    return {"damage": text, "damaged_part": part}
+
+
 def evaluate_suite(
     task: MazeTaskBase,
     network,
@@ -160,7 +178,8 @@ def evaluate_suite(
             a cell, well below the 0.1 m that counts.
 
     Raises:
-        ValueError: the set perturbs something but the task takes no perturbations.
+        ValueError: the set perturbs something but the task takes no perturbations, or
+            names a damage the robot's simulation cannot apply.
     """
     rng = np.random.default_rng([seed, 0])
     starts = np.concatenate(
@@ -182,6 +201,7 @@ def evaluate_suite(
     if perturbation is not NONE:
         if not takes:
             raise ValueError("this robot's maze task takes no perturbations")
+        check_damage(task, perturbation)
         world = perturbation.draw(np.random.default_rng([seed, 1]), len(starts))
         starts = world.shift_starts(starts, task.mazes, task.footprint_radius)
     result = task.evaluate([network], controller, starts, record=True, world=world)
@@ -212,6 +232,7 @@ def evaluate_suite(
                 collided=bool(touching.any()),
                 contact_share=float(touching.mean()),
                 fell=bool(result.fell[e]) if result.fell is not None else False,
+                **_damage(world, e, task),
             )
         )
         paths.append(pose)

@@ -39,7 +39,8 @@ from evorbc_ros import mapping as onboard_mapping
 from offline_evolution.arbitrator.compiled import activate, activate_recurrent
 from sim_bridge.four_ws.motion import HEADING, STATE_SIZE, X, Y, speed_through_wheels
 from sim_bridge.geometry import grid_candidates
-from sim_bridge.kinematics import halt, step_model
+from sim_bridge.hashing import hash_uniform as _hash_uniform
+from sim_bridge.kinematics import halt, step_model, step_model_damaged
 from sim_bridge.sensors import read_sensors
 
 map_point = nb.njit(cache=True)(onboard_mapping.map_point)
@@ -73,26 +74,15 @@ class WorldDraws(NamedTuple):
 
     Attributes:
         on: apply the draws; otherwise the arrays may be 1-sized and are not read.
-        params: ``(E, 4)`` wheel speed gain, latency (cycles), reading noise sd, dropout
-            probability.
+        params: ``(E, 7)`` wheel speed gain, latency (cycles), reading noise sd, dropout
+            probability, then a damaged wheel's kind (0: intact), wheel and level
+            (:meth:`sim_bridge.damage.DamageDraw.wheel_arrays`).
         keys: ``(E,)`` int64 key of each episode's noise.
     """
 
     on: bool
     params: np.ndarray
     keys: np.ndarray
-
-
-@nb.njit(cache=True)
-def _hash_uniform(key, cycle, index, salt):
-    """A uniform number in [0, 1) from ``(key, cycle, index, salt)`` (splitmix64's mixer)."""
-    z = np.uint64(key) + np.uint64(cycle * 1024 + index * 4 + salt + 1) * np.uint64(
-        0x9E3779B97F4A7C15
-    )
-    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-    z = z ^ (z >> np.uint64(31))
-    return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
 @nb.njit(cache=True)
@@ -158,11 +148,14 @@ def _candidates(m, x, y, world):
 
 @nb.njit(cache=True, inline="always")
 def _world_draw(draws, e):
-    """``(gain, latency cycles, noise sd, dropout, key)`` of episode ``e``; nominal when off."""
+    """``(gain, latency cycles, noise sd, dropout, key, damaged)`` of episode ``e``.
+
+    Nominal (and intact) when off.
+    """
     if draws.on:
         p = draws.params
-        return p[e, 0], int(p[e, 1]), p[e, 2], p[e, 3], draws.keys[e]
-    return 1.0, 0, 0.0, 0.0, np.int64(0)
+        return p[e, 0], int(p[e, 1]), p[e, 2], p[e, 3], draws.keys[e], p[e, 4] != 0.0
+    return 1.0, 0, 0.0, 0.0, np.int64(0), False
 
 
 @nb.njit(cache=True, inline="always")
@@ -249,25 +242,31 @@ def _record(pose, choice_trace, output_trace, e, t, x, y, h, choice, out):
 
 
 @nb.njit(cache=True, inline="always")
-def _act(state, e, t, command, scaled, gain, pending, latency, lim, boxes, cand):
+def _act(
+    state, e, t, command, scaled, gain, pending, latency, lim, boxes, cand, damaged, damage, key
+):
     """Step robot ``e`` one cycle on ``command``, through a perturbed world if ``scaled``.
 
     Every branch of :func:`_decide` set the speeds afresh this cycle. A wheel speed gain
     scales the 4WS speed, and both v and omega of a differential drive (every wheel turns
     faster by the same factor). With ``latency`` cycles, the command of ``latency`` cycles
     ago is applied and this one queued in ``pending`` (a ring starting as stops).
+    ``damaged``: step with the damaged wheel ``damage`` (``(3,)`` kind, wheel, level);
+    otherwise the intact model runs, bit for bit as without damage sets.
     """
     if scaled:
         command[0] *= gain
         if command.shape[0] == 2:
             command[1] *= gain
+    applied = command
     if latency > 0:
         slot = t % latency
         applied = pending[slot].copy()
         pending[slot, :] = command
-        step_model(state, e, applied, lim, boxes, cand)
+    if damaged:
+        step_model_damaged(state, e, applied, lim, boxes, cand, damage, key, t)
     else:
-        step_model(state, e, command, lim, boxes, cand)
+        step_model(state, e, applied, lim, boxes, cand)
 
 
 @nb.njit(cache=True, inline="always")
@@ -346,7 +345,10 @@ def run_episodes(
         # executor does, which start at 0. Differential drive: (v m/s, omega rad/s).
         command = np.zeros(width)
         before = np.empty(STATE_SIZE)
-        gain, latency, noise_sd, dropout, key = _world_draw(draws, e)
+        gain, latency, noise_sd, dropout, key, damaged = _world_draw(draws, e)
+        damage = draws.params[0, 4:7]  # read only when damaged
+        if damaged:
+            damage = draws.params[e, 4:7]
         # Commands still on their way to the wheels (latency), starting as stops.
         pending = np.zeros((max(latency, 1), width))
         # The motion input's ring: position of cycle t in row t % (window + 1) (m).
@@ -366,7 +368,10 @@ def run_episodes(
                 _record(pose, choice_trace, output_trace, e, t, x, y, h, choice, out)
             for k in range(STATE_SIZE):
                 before[k] = state[e, k]
-            _act(state, e, t, command, drawn, gain, pending, latency, lim, world.boxes, cand)
+            _act(
+                state, e, t, command, drawn, gain, pending, latency, lim, world.boxes, cand,
+                damaged, damage, key,
+            )  # fmt: skip
             dist = math.hypot(state[e, X] - tx, state[e, Y] - ty)
             if dist <= world.target_radius[m]:
                 reached[e] = True

@@ -23,6 +23,7 @@ from evorbc_ros.robots.primitive import ParameterSpec
 from offline_evolution.maze_task.base import MazeTaskBase, MazeTaskSettings, empty_traces
 from offline_evolution.maze_task.perturbation import PYBULLET_LEGGED
 from offline_evolution.task_protocol import EpisodeResult
+from sim_bridge.damage import LEGGED_DAMAGE
 from sim_bridge.legged.episode import EpisodeRunner, LeggedController, LeggedWorld
 from sim_bridge.legged.pool import SpawnedWorkers, available_cores, ignore_sigint
 from sim_bridge.legged.scanner import Scanner
@@ -62,6 +63,8 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
 
     #: What of a perturbation set its simulation applies (docs/design.md section 21).
     perturbations_applied = PYBULLET_LEGGED
+    #: The kinds of damage it applies (docs/perturbations.md).
+    damage_applied = LEGGED_DAMAGE
 
     def __init__(
         self,
@@ -72,6 +75,8 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
         if not isinstance(robot, LeggedRobotSettings):
             robot = load_robot_settings(robot)
         self.robot = robot
+        #: The legs a damage set can hit, by foot link (docs/perturbations.md).
+        self.damage_legs = tuple(robot.foot_links)
         if robot.footprint_radius is None:
             raise ConfigError(f"{robot.source}: footprint_radius: needed for the maze task")
         super().__init__(settings, robot.control_period, robot.footprint_radius, robot.name)

@@ -36,7 +36,9 @@ from offline_evolution.maze_task.kernel import (
 from offline_evolution.maze_task.perturbation import KINEMATIC
 from offline_evolution.maze_task.world import MazePiece, combine_pieces, maze_piece
 from offline_evolution.task_protocol import EpisodeResult
+from sim_bridge.damage import FOUR_WS_DAMAGE
 from sim_bridge.diff_drive.robot import DiffDriveRobot
+from sim_bridge.four_ws.motion import MotionLimits
 from sim_bridge.four_ws.robot import FourWSRobot
 from sim_bridge.sensors import compile_layout
 
@@ -148,6 +150,9 @@ class MazeTask(MazeTaskBase):
 
             robot = make_robot(robot)
         self.robot = robot
+        #: The kinds of damage its simulation applies (docs/perturbations.md): a 4WS
+        #: robot's wheels one by one; a differential drive's none.
+        self.damage_applied = FOUR_WS_DAMAGE if isinstance(robot.limits, MotionLimits) else ()
         super().__init__(settings, robot.control_period, robot.footprint_radius, robot.name)
         self.sensors = compile_layout(self.layout, robot.control_period)
         # Walls a ray or the footprint can touch from a cell: sensor reach plus a step and
@@ -213,7 +218,7 @@ class MazeTask(MazeTaskBase):
             params = np.tile(world.kernel_arrays(self.sensors.max_range), (len(genomes), 1))
             keys = np.tile(world.keys, len(genomes))
         else:
-            params, keys = np.ones((1, 4)), np.zeros(1, dtype=np.int64)
+            params, keys = np.zeros((1, 7)), np.zeros(1, dtype=np.int64)
         with numba.parallel_chunksize(_CHUNK):
             reached, cycles, final, initial, end = run_episodes(
                 genome,

@@ -131,6 +131,8 @@ def _evaluate(run: EvaluateRun, report: Reporters) -> EvaluateOutcome:
         "not_applicable": list(suite.not_applicable),
         "per_maze": suite.per_maze(),
         "overall": suite.overall(),
+        # Per damaged wheel, leg or side, for a set with damage (docs/perturbations.md).
+        **({"per_damage": suite.per_damage()} if perturbation.damage else {}),
         "episodes": [e.as_dict() for e in suite.episodes],
     }
     if run.out:

@@ -126,6 +126,7 @@ class SimBridgeNode(Node):
             kind = bridge_robot_class(robot)
             pose = self._start_pose(maze, p["start"], p["seed"], spec.footprint_radius, robot)
             self.robot = kind(self, robot, maze, pose, episode_time, p["gui"])
+            self._perturb(p["perturb"], p["seed"])
         ParameterGuard(self, PARAMETERS, "at start-up")
         self.steps = Meter()
         self.diagnostics = DiagnosticsPublisher(self, p["diagnostics_period"], self.health, robot)
@@ -191,6 +192,48 @@ class SimBridgeNode(Node):
         return x, y, math.radians(h)
 
     # -- commands ----------------------------------------------------------------------
+
+    def _perturb(self, name: str, seed: int) -> None:
+        """Apply one world of perturbation set ``name``, drawn from ``default_rng([seed, 1])``.
+
+        Logs the world and what of the set this robot's bridge cannot apply.
+        """
+        if name == "none":
+            return
+        from sim_bridge.perturbation import load_perturbations
+
+        try:
+            perturbation = load_perturbations(name)
+        except ConfigError as e:
+            raise StartupError(f"parameter perturb: {e}") from None
+        draw = perturbation.draw(np.random.default_rng([seed, 1]), 1)
+        try:
+            applied = self.robot.perturb(draw)
+        except ConfigError as e:  # a fixed leg this robot has not
+            raise StartupError(f"parameter perturb {name}: {e}") from None
+        if perturbation.damage is not None and perturbation.damage.kind not in applied:
+            raise StartupError(
+                f"parameter perturb {name}: this robot's simulation cannot apply damage "
+                f"{perturbation.damage.kind}"
+            )
+        wanted = perturbation.perturbed()
+        row = draw.row(0)
+        shown = {q: round(v, 4) for q, v in row.items() if q in wanted}
+        damage = ""
+        if "damage" in row:
+            from sim_bridge.damage import describe, part_names
+
+            settings = getattr(self.robot.world, "settings", None)
+            legs = tuple(getattr(settings, "foot_links", ()))
+            damage = "; " + describe(row["damage"], part_names(row["damage"]["kind"], legs))[1]
+        self.get_logger().info(
+            f"perturbation set {perturbation.name} (seed {seed}): {shown}{damage}"
+        )
+        skipped = [q for q in wanted if q not in applied]
+        if skipped:
+            self.get_logger().warning(
+                f"parameter perturb {name}: the bridge does not apply {', '.join(skipped)}"
+            )
 
     def on_command(self, key: str) -> None:
         """A valid command for ``key`` has been stored by the robot adapter."""

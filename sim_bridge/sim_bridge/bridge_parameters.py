@@ -29,7 +29,13 @@ PARAMETERS = (
     ),
     spec("gui", False, "open the PyBullet window"),
     spec("start", "nominal", "start pose: nominal, random, or 'x,y,heading_deg'"),
-    spec("seed", 0, "seed of a random start", 0, 2**32 - 1),
+    spec("seed", 0, "seed of a random start and of the perturbed world", 0, 2**32 - 1),
+    spec(
+        "perturb",
+        "none",
+        "perturbation or damage set for the simulated robot: none, a shipped set's name "
+        "(config/perturbations) or a YAML file; one world drawn from the seed",
+    ),
     spec(
         "episode_time",
         0.0,

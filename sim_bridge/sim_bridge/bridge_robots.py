@@ -20,6 +20,7 @@ import numpy as np
 
 from evorbc_ros.nodes.common import StartupError, robot_named
 from evorbc_ros.robots.registry import RobotError
+from sim_bridge.perturbation import WorldDraw
 from sim_bridge.robots.adapters import bridge_class
 from sim_bridge.world import LaserConfig
 
@@ -53,6 +54,20 @@ class KinematicBridge:
     def scan(self) -> np.ndarray:
         """Laser ranges (m)."""
         return self.world.scan()
+
+    def perturb(self, draw: WorldDraw) -> tuple[str, ...]:
+        """Apply row 0 of a perturbation set's ``draw``; the quantities applied.
+
+        The kinematic world takes the wheel speed gain and a 4WS robot's damaged wheel
+        (docs/perturbations.md); the rest of a set is the offline episodes' alone.
+        """
+        self.world.speed_gain = float(draw.values["wheel_speed_gain"][0])
+        applied = ["wheel_speed_gain"]
+        if draw.damage is not None and draw.damage.spec.family == "four_ws":
+            self.world.damage = draw.kernel_arrays(1.0)[0, 4:7].copy()
+            self.world.damage_key = int(draw.keys[0])
+            applied.append(draw.damage.spec.kind)
+        return tuple(applied)
 
     def body_pose(self) -> tuple[tuple, tuple]:
         """Position (m) and orientation (xyzw) of ``base_link`` in ``odom``: planar."""

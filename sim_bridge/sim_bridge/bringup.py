@@ -83,7 +83,15 @@ def parse_args(argv=None) -> argparse.Namespace:
         help="lockstep: deterministic and fast (default); realtime: 10 Hz wall clock",
     )
     p.add_argument("--start", default="nominal", help="nominal, random or 'x,y,heading_deg'")
-    add_seed(p, "seed of a random start")
+    add_seed(p, "seed of a random start and of the perturbed world")
+    p.add_argument(
+        "--perturb",
+        default="none",
+        metavar="none|NAME|FILE.yaml",
+        help="perturbation or damage set for the simulated robot (config/perturbations/: "
+        "realistic, 4ws-stuck-steering, hexapod-leg-lost, ...; docs/perturbations.md); one "
+        "world drawn from --seed",
+    )
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--plot", default="", help="trajectory picture (default: <maze>-run.png)")
     p.add_argument("--result", default="", help="also keep the result as JSON here")
@@ -184,6 +192,7 @@ def start_graph(
         repertoire=args.repertoire or "",  # empty: the shipped one
         start=args.start,
         seed=args.seed,
+        perturb=args.perturb,
         result_file=result_file,
         bag=args.bag,
         maze_scale=args.maze_scale,
@@ -251,6 +260,7 @@ def prepare(args: argparse.Namespace) -> tuple[Controller, Maze, str]:
     if warning:
         report(warning)
     check_start(args.start, args.seed, maze, arb.robot)
+    check_perturb(args.perturb, arb.robot)
     plot = args.plot or f"{maze.name}-run.png"
     check_output_file(plot, "--plot", picture=True)
     if args.result:
@@ -258,6 +268,30 @@ def prepare(args: argparse.Namespace) -> tuple[Controller, Maze, str]:
     if args.bag:
         check_new_bag(args.bag)
     return controller, maze, plot
+
+
+#: The families whose bridge is PyBullet's legged robot (they take legged damage).
+LEGGED = ("hexapod", "legged")
+
+
+def check_perturb(name: str, robot: str) -> None:
+    """Refuse a ``--perturb`` set that does not load, or whose damage ``robot`` cannot take.
+
+    Raises:
+        ConfigError: one line naming ``--perturb``.
+    """
+    from sim_bridge.perturbation import load_perturbations
+
+    try:
+        damage = load_perturbations(name).damage
+    except ConfigError as e:
+        raise ConfigError(f"--perturb: {e}") from None
+    family = registry.lookup(robot).family
+    fits = family == "four_ws" if damage and damage.family == "four_ws" else family in LEGGED
+    if damage is not None and not fits:
+        raise ConfigError(
+            f"--perturb {name}: damage {damage.kind} is for {damage.family} robots, not {robot}"
+        )
 
 
 def check_new_bag(path: str) -> None:

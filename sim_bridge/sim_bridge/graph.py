@@ -77,7 +77,13 @@ ARGUMENTS = (
         "repertoire file (JSON); empty: the one shipped for the arbitrator's robot",
     ),
     Argument("start", "nominal", "start pose: nominal, random, or 'x,y,heading_deg'"),
-    Argument("seed", "0", "seed of a random start (integer >= 0)"),
+    Argument("seed", "0", "seed of a random start and of the perturbed world (integer >= 0)"),
+    Argument(
+        "perturb",
+        "none",
+        "perturbation or damage set for the simulated robot: none, a name in "
+        "config/perturbations/ or a YAML file (docs/perturbations.md)",
+    ),
     Argument(
         "namespace",
         "",
@@ -261,6 +267,7 @@ def sim_graph(
     repertoire: str = "",
     start: str = "nominal",
     seed: int = 0,
+    perturb: str = "none",
     namespace: str = "",
     result_file: str = "",
     record_file: str = "",
@@ -342,6 +349,8 @@ def sim_graph(
                         "gui": gui,
                         "start": start,
                         "seed": seed,
+                        # Only when asked: an intact graph passes no perturb parameter.
+                        **({"perturb": perturb} if perturb != "none" else {}),
                         "result_file": result_file,
                         "episode_time": trained_episode_time(arbitrator) or "",
                         **laser_range(arbitrator),
@@ -389,6 +398,7 @@ def graph_from_arguments(values: dict[str, str]) -> SimGraph:
             repertoire=given["repertoire"],
             start=given["start"],
             seed=seed,
+            perturb=given["perturb"],
             namespace=given["namespace"],
             paper=paper,
             bag=given["bag"],

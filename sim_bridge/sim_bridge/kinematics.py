@@ -16,12 +16,22 @@ from numba import types
 from numba.extending import overload
 
 from sim_bridge.diff_drive.motion import DiffLimits, step_diff
+from sim_bridge.four_ws.damaged import step_damaged
 from sim_bridge.four_ws.motion import HEADING, STATE_SIZE, MotionLimits, X, Y, step_robot
 
 
 def step_model(state, i, command, lim, boxes, candidates):
     """Advance robot ``i`` one control step in the motion model of ``lim`` (compiled only)."""
     raise NotImplementedError("step_model runs inside compiled code only")
+
+
+def step_model_damaged(state, i, command, lim, boxes, candidates, damage, key, cycle):
+    """:func:`step_model` with a damaged wheel (compiled only; 4WS, docs/perturbations.md).
+
+    ``damage``: ``(3,)`` kind, wheel, level; ``key``, ``cycle``: a slipping wheel's draw. A
+    differential drive takes no wheel damage (its task refuses it) and steps intact.
+    """
+    raise NotImplementedError("step_model_damaged runs inside compiled code only")
 
 
 def halt(command, lim):
@@ -47,6 +57,23 @@ def _step_model(state, i, command, lim, boxes, candidates):
     if _model(lim) is DiffLimits:
 
         def diff_drive(state, i, command, lim, boxes, candidates):
+            return step_diff(state, i, command, lim, boxes, candidates)
+
+        return diff_drive
+    return None
+
+
+@overload(step_model_damaged, inline="always")
+def _step_model_damaged(state, i, command, lim, boxes, candidates, damage, key, cycle):
+    if _model(lim) is MotionLimits:
+
+        def four_ws(state, i, command, lim, boxes, candidates, damage, key, cycle):
+            return step_damaged(state, i, command, lim, boxes, candidates, damage, key, cycle)
+
+        return four_ws
+    if _model(lim) is DiffLimits:
+
+        def diff_drive(state, i, command, lim, boxes, candidates, damage, key, cycle):
             return step_diff(state, i, command, lim, boxes, candidates)
 
         return diff_drive

@@ -110,6 +110,12 @@ class KinematicWorld:
         tx, ty = maze.target
         self.initial_distance = math.hypot(self.state[0, X] - tx, self.state[0, Y] - ty)
         self.reached = False
+        # A perturbation set's draw (docs/perturbations.md): a factor on the commanded wheel
+        # speed, and a 4WS robot's damaged wheel ((3,) kind, wheel, level; None: intact)
+        # with the key of its per-cycle draws.
+        self.speed_gain = 1.0
+        self.damage: np.ndarray | None = None
+        self.damage_key = 0
         self.physics.show_pose(*self.pose)
 
     def _model(self, robot: str, geometry) -> None:
@@ -145,7 +151,12 @@ class KinematicWorld:
             Distance travelled (m); 0 if the wheels fought or a wall was in the way.
         """
         x0, y0 = self.state[0, X], self.state[0, Y]
-        moved = self._move(np.asarray(command, dtype=np.float64))
+        command = np.array(command, dtype=np.float64)
+        if self.speed_gain != 1.0:  # as the episode kernel scales it (docs/design.md s. 21)
+            command[0] *= self.speed_gain
+            if len(command) == 2:
+                command[1] *= self.speed_gain
+        moved = self._move(command)
         if moved > 0.0 and not self.physics.footprint_clear(self.state[0, X], self.state[0, Y]):
             self.state[0, X], self.state[0, Y] = x0, y0
             moved = 0.0

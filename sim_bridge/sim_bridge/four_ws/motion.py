@@ -254,8 +254,18 @@ def step_robot(state, i, command, lim, boxes, candidates):
         distance,
         lim,
     )
-    if not moved:
+    if not moved or not move_body(state, i, dx, dy, dheading, lim, boxes, candidates):
         return 0.0
+    return abs(distance)
+
+
+@nb.njit(cache=True, inline="always")
+def move_body(state, i, dx, dy, dheading, lim, boxes, candidates):
+    """Move robot ``i`` by ``(dx, dy)`` (m, body frame at the step's start) and ``dheading``.
+
+    The heading change is always kept; the position only if the footprint stays clear of
+    the walls (docs/design.md section 2). Returns whether the position moved.
+    """
     heading = state[i, HEADING]
     c = math.cos(heading)
     s = math.sin(heading)
@@ -263,7 +273,7 @@ def step_robot(state, i, command, lim, boxes, candidates):
     ny = state[i, Y] + s * dx + c * dy
     state[i, HEADING] = heading + dheading
     if candidates.shape[0] > 0 and clearance(nx, ny, boxes, candidates) < lim.footprint_radius:
-        return 0.0
+        return False
     state[i, X] = nx
     state[i, Y] = ny
-    return abs(distance)
+    return True

@@ -1,7 +1,8 @@
 """The bridge's world for a 4WS robot: the kinematic world with the 4WS motion model.
 
 The robot moves by :func:`sim_bridge.four_ws.motion.step_robot`, the model offline
-evolution steps (docs/design.md section 2); the maze, walls, laser and episode are
+evolution steps (docs/design.md section 2), or with a damaged wheel by
+:func:`sim_bridge.four_ws.damaged.step_damaged`; the maze, walls, laser and episode are
 :class:`~sim_bridge.world.KinematicWorld`'s.
 """
 
@@ -10,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from evorbc_ros.robots.registry import robot_type
+from sim_bridge.four_ws.damaged import step_damaged
 from sim_bridge.four_ws.motion import ANGLE_FL, SPEED, STATE_SIZE, motion_limits, step_robot
 from sim_bridge.world import KinematicWorld
 
@@ -34,6 +36,11 @@ class FourWSWorld(KinematicWorld):
         self.n_wheels = 4
 
     def _move(self, command: np.ndarray) -> float:
+        if self.damage is not None:  # cycle: the one this step runs, as the kernel's t
+            return step_damaged(
+                self.state, 0, command, self.limits, _NO_BOXES, _NO_CANDIDATES,
+                self.damage, self.damage_key, self.cycles,
+            )  # fmt: skip
         return step_robot(self.state, 0, command, self.limits, _NO_BOXES, _NO_CANDIDATES)
 
     def _roll_wheels(self, wheel_radius: float) -> None:

@@ -10,6 +10,7 @@ hexapod's.
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import numpy as np
@@ -20,8 +21,10 @@ from evorbc_ros.nodes.common import RELIABLE
 from evorbc_ros.robots import registry
 from sim_bridge.bridge_robots import ScanGeometry
 from sim_bridge.legged.maze_world import LeggedMazeWorld
+from sim_bridge.legged.perturbed import perturbed_sim
 from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.legged.settings import load_robot_settings
+from sim_bridge.perturbation import WorldDraw
 
 
 class TrajectoryBridge:
@@ -112,6 +115,27 @@ class TrajectoryBridge:
     def scan(self) -> np.ndarray:
         """Laser ranges (m), float32 as LaserScan carries them."""
         return self.world.scan()
+
+    def perturb(self, draw: WorldDraw) -> tuple[str, ...]:
+        """Apply row 0 of a perturbation set's ``draw`` for the run; the quantities applied.
+
+        The robot's dynamics: friction, mass, payload, servos and damage
+        (:func:`~sim_bridge.legged.perturbed.perturbed_sim`, left in force until the
+        world closes); the rest of a set is the offline episodes' alone.
+        """
+        stack = contextlib.ExitStack()
+        stack.enter_context(perturbed_sim(self.world.sim, draw.row(0)))
+        close = self.world.close
+
+        def put_back_and_close() -> None:
+            stack.close()  # while PyBullet is still connected
+            close()
+
+        self.world.close = put_back_and_close
+        applied = ("friction", "body_mass", "payload", "servo_strength", "servo_speed")
+        if draw.damage is not None and draw.damage.spec.family == "legged":
+            applied += (draw.damage.spec.kind,)
+        return applied
 
     def twist(self) -> tuple[float, float]:
         """Forward speed (m/s) and yaw rate (rad/s) of the body, body frame."""

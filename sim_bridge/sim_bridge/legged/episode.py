@@ -171,7 +171,7 @@ class EpisodeRunner:
         """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index`` (or a Maze).
 
         ``world``: a perturbed world's row
-        (:meth:`~offline_evolution.maze_task.perturbation.WorldDraw.row`), or None.
+        (:meth:`~sim_bridge.perturbation.WorldDraw.row`), or None.
 
         Returns:
             ``{"reached", "fell", "cycles", "final_distance", "initial_distance", "start_xy",

@@ -1,10 +1,11 @@
 """Perturbed worlds in a legged robot's PyBullet episode (docs/design.md section 21).
 
-A perturbed world (one :meth:`~offline_evolution.maze_task.perturbation.WorldDraw.row`)
+A perturbed world (one :meth:`~sim_bridge.perturbation.WorldDraw.row`)
 changes the ground's friction, the root link's mass (and a payload at its centre of mass)
 and the servos' torque and speed for one episode, and puts them back after it
 (:func:`perturbed_sim`); it adds noise to the laser's beams and loses some
-(:func:`perturbed_ranges`, seeded by the episode's key). The episode runner delays
+(:func:`perturbed_ranges`, seeded by the episode's key), and damages a leg or a side
+(:mod:`sim_bridge.legged.damaged`). The episode runner delays
 primitives by whole cycles (:mod:`sim_bridge.legged.episode`). Nothing is changed for
 identity values, so an unperturbed world runs the nominal simulation bit for bit.
 """
@@ -18,6 +19,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from sim_bridge.legged.damaged import apply_damage
 from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.quiet_pybullet import p
 
@@ -26,11 +28,11 @@ from sim_bridge.quiet_pybullet import p
 def perturbed_sim(sim: LeggedSim, world: dict | None) -> Iterator[None]:
     """Run the block with ``sim``'s friction, mass and servos as ``world`` draws them.
 
-    ``world``: one :meth:`~offline_evolution.maze_task.perturbation.WorldDraw.row` (factors
+    ``world``: one :meth:`~sim_bridge.perturbation.WorldDraw.row` (factors
     ``friction``, ``body_mass``, ``servo_strength``, ``servo_speed``; ``payload`` as a share
-    of the body's mass), or None. The body is the URDF's root link (the hexapod's box, the
-    A1's trunk). Only values other than the identity are touched, and the nominal ones are
-    put back afterwards (a saved state does not hold dynamics).
+    of the body's mass, ``damage`` if any), or None. The body is the URDF's root link (the
+    hexapod's box, the A1's trunk). Only values other than the identity are touched, and the
+    nominal ones are put back afterwards (a saved state does not hold dynamics).
     """
     if not world:
         yield
@@ -41,6 +43,7 @@ def perturbed_sim(sim: LeggedSim, world: dict | None) -> Iterator[None]:
     mass, inertia = info[0], info[2]  # kg and kg m^2 (principal axes) of the root link
     torques, settings = list(sim.torques), sim.settings
     mass_factor = world["body_mass"] + world["payload"]
+    restore = None
     try:
         if world["friction"] != 1.0:
             # Contact friction is the product of both bodies' coefficients: scaling the
@@ -59,6 +62,8 @@ def perturbed_sim(sim: LeggedSim, world: dict | None) -> Iterator[None]:
             )
         if world["servo_strength"] != 1.0:
             sim.torques = [t * world["servo_strength"] for t in torques]
+        if world.get("damage"):  # after the strength: a weak leg is weaker still
+            restore = apply_damage(sim, world["damage"], sim.torques)
         if world["servo_speed"] != 1.0:
             servo = dataclasses.replace(
                 settings.servo, max_velocity=settings.servo.max_velocity * world["servo_speed"]
@@ -72,7 +77,9 @@ def perturbed_sim(sim: LeggedSim, world: dict | None) -> Iterator[None]:
             p.changeDynamics(
                 sim.robot, -1, mass=mass, localInertiaDiagonal=inertia, physicsClientId=c
             )
-        sim.torques, sim.settings = torques, settings
+        sim.torques, sim.settings, sim.locked = torques, settings, {}
+        if restore is not None:
+            restore()
 
 
 def perturbed_ranges(ranges: np.ndarray, world: dict | None, cycle: int) -> np.ndarray:

@@ -101,6 +101,9 @@ class LeggedSim:
             self.close()
             raise
         self.torques = list(settings.servo.torques)
+        # Damage (docs/perturbations.md): joint column -> angle (rad) its servo holds
+        # whatever the targets say (a locked knee); empty for the intact robot.
+        self.locked: dict[int, float] = {}
         self.steps_done = 0  # physics steps since the last reset
         self._rest_state, self._rest_pose = self._settle()
         self.steps_done = 0  # the clock starts at rest
@@ -294,7 +297,12 @@ class LeggedSim:
         # any x, ``v if x > v else (-v if x < -v else x)`` is ``np.clip(x, -v, v)`` (NaN
         # included).
         v_min = -v_max
-        for target in np.asarray(targets, dtype=np.float64).tolist():
+        targets = np.asarray(targets, dtype=np.float64)
+        if self.locked:
+            targets = targets.copy()
+            for column, angle in self.locked.items():
+                targets[:, column] = angle
+        for target in targets.tolist():
             velocity = []
             states = get_states(robot, joints, physicsClientId=c)
             for q_target, state in zip(target, states, strict=True):
