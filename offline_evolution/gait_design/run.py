@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from pathlib import Path
 
 from evorbc_ros.atomic_io import atomic_write_text
-from evorbc_ros.config import ConfigError, load_yaml_mapping
+from evorbc_ros.config import load_yaml_mapping
 from offline_evolution.gait_design.objective import FORMULA, Budget
 from offline_evolution.gait_design.search import DesignSearch, SearchResult
 from offline_evolution.gait_design.space import DesignSpace
@@ -85,7 +84,8 @@ def design_gait(
         should_stop: polled between designs.
 
     Raises:
-        UserError, ConfigError, CheckpointError, Interrupted: one line each.
+        UserError, ConfigError, CheckpointError: one line each.
+        Interrupted: ``should_stop`` said stop; the checkpoint holds every design scored.
 
     """
     text, data = legged_settings(settings)
@@ -115,6 +115,4 @@ def design_gait(
         f"{result.current_search.score:.3f} on the search's primitives; "
         f"{len(result.candidates)} designs scored; wrote {out}"
     )
-    if not math.isfinite(result.chosen_validation.score):
-        raise ConfigError(f"{settings}: no design could be scored")
     return result
