@@ -53,6 +53,7 @@ class Scored:
     measures: DesignMeasures
     score: float
     seconds: float  # wall time it took (0 when read from the checkpoint)
+    cpu_seconds: float = 0.0  # this process's CPU time it took
 
     def as_dict(self) -> dict:
         """Plain data for the checkpoint."""
@@ -185,7 +186,7 @@ class DesignSearch:
                 raise CheckpointError(f"{self.checkpoint}: design {i + 1}: bad measures") from None
             result = Scored(stage, values, measures, float(entry["score"]), 0.0)
         else:
-            start = time.perf_counter()
+            start, cpu = time.perf_counter(), time.process_time()
             design = self.space.design(values)
             b = self.budget
             measures = measure_design(
@@ -198,7 +199,8 @@ class DesignSearch:
                 self._reference(values, which),
             )
             s = score(measures, values["rate_hz"], design.speed_bound)
-            result = Scored(stage, values, measures, s, time.perf_counter() - start)
+            wall, cpu = time.perf_counter() - start, time.process_time() - cpu
+            result = Scored(stage, values, measures, s, wall, cpu)
         self.done.append(result)
         if i >= len(self.saved) and len(self.done) % self.every == 0:
             self._save()
@@ -209,7 +211,9 @@ class DesignSearch:
         v, m = r.values, r.measures
         scales = ", ".join(f"{g} x{s:.2f}" for g, s in v["scale"].items())
         error = f"{100 * m.endpoint_error:.1f} cm" if np.isfinite(m.endpoint_error) else "-"
-        when = f"{r.seconds:.1f} s" if r.seconds else "from the checkpoint"
+        when = (
+            f"{r.seconds:.1f} s, CPU {r.cpu_seconds:.1f} s" if r.seconds else "from the checkpoint"
+        )
         return (
             f"design {len(self.done)} ({r.stage}): gain {v['gain']:g}/s, "
             f"{v['frequency_hz']:g} Hz gait, {v['rate_hz']:g} Hz physics, ranges {scales}: "
