@@ -32,6 +32,7 @@ import numpy as np
 
 from evorbc_ros.config import load_yaml_mapping
 from sim_bridge.legged.evaluate import TILT, X, Y, evaluate_genes
+from sim_bridge.legged.gait_measures import switching_episode as episode
 from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.legged.settings import robot_settings_from_mapping
 
@@ -176,19 +177,6 @@ VARIANTS = {
     ],
     "chosen (config/robots/a1.yaml)": [],
 }
-
-
-def episode(sim: LeggedSim, table, rows: np.ndarray, hold: int, fallen: float) -> bool:
-    """Run ``rows[k // hold]`` in cycle ``k``; True if the robot fell over."""
-    sim.reset()
-    steps = sim.physics.steps(sim.settings.control_period)
-    for cycle in range(len(rows) * hold):
-        row = rows[cycle // hold]
-        targets = table.joint_targets(sim.step_times(steps), np.full(steps, row))
-        tilt, _ = sim.run(targets, fallen)
-        if tilt > fallen:
-            return True
-    return False
 
 
 def study(name: str, changes, args) -> dict:

@@ -15,9 +15,7 @@ docs/hexapod.md record the figures.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
-import math
 import os
 import platform
 import time
@@ -25,20 +23,18 @@ import time
 import numpy as np
 
 from evorbc_ros.repertoire import Repertoire
-from sim_bridge.legged.evaluate import HEADING, TILT, X, Y, evaluate_genes
+from sim_bridge.legged.evaluate import HEADING, TILT, evaluate_genes
+from sim_bridge.legged.gait_measures import (
+    NO_EARLY_STOP,
+    REFERENCE,
+    T,
+    endpoint_errors,
+    with_physics,
+)
 from sim_bridge.legged.physics import LeggedSim
 from sim_bridge.legged.settings import LeggedRobotSettings, load_robot_settings
 
-T = 2.0
-NO_EARLY_STOP = math.radians(180.0)  # run every primitive the full T to compare endpoints
-REFERENCE = (1000.0, 50)
 CANDIDATES = "50/50,100/30,100/50,150/50,200/30,200/50,250/50,500/50"
-
-
-def with_physics(settings: LeggedRobotSettings, rate: float, iterations: int):
-    """``settings`` simulated at ``rate`` Hz with ``iterations`` solver iterations."""
-    physics = dataclasses.replace(settings.physics, rate=rate, solver_iterations=iterations)
-    return dataclasses.replace(settings, physics=physics)
 
 
 def run(settings: LeggedRobotSettings, genes: np.ndarray) -> tuple[np.ndarray, float]:
@@ -53,7 +49,7 @@ def run(settings: LeggedRobotSettings, genes: np.ndarray) -> tuple[np.ndarray, f
 def compare(rows: np.ndarray, ref: np.ndarray, discard: float) -> dict:
     """Errors of ``rows`` against the reference, over primitives the reference keeps."""
     kept = ref[:, TILT] <= discard
-    err = np.hypot(rows[kept, X] - ref[kept, X], rows[kept, Y] - ref[kept, Y])
+    err = endpoint_errors(rows, ref, discard)
     heading = np.degrees(np.abs(rows[kept, HEADING] - ref[kept, HEADING]))
     return {
         "kept": int(kept.sum()),

@@ -10,6 +10,7 @@ Subcommands:
     evaluate     run a controller on a suite of mazes from many starts, perturbed or not
     recipe       make a shipped controller from its recipe (config/recipes/*.yaml)
     robot-from-urdf  a legged robot's settings files read from its URDF
+    design-gait  a legged robot's gait design (gain, ranges, frequency, physics rate) by search
 
 Bad arguments or files end the program with a one-line message and a non-zero status,
 never a traceback (set ``EVORBC_DEBUG=1`` to see one for an unexpected failure).
@@ -24,6 +25,7 @@ from collections.abc import Sequence
 
 from offline_evolution.commands import (
     arbitrator,
+    design_gait,
     evaluate,
     mazes,
     recipe,
@@ -51,6 +53,7 @@ def build_parser() -> argparse.ArgumentParser:
     evaluate.add_parsers(sub)
     recipe.add_parsers(sub)
     robot_from_urdf.add_parsers(sub)
+    design_gait.add_parsers(sub)
     return parser
 
 

@@ -30,8 +30,8 @@ def loader_keys() -> set[str]:
         ("tilt", legged_settings._Tilt),
     ):
         keys |= {f"{section}.{f.name}" for f in dataclasses.fields(cls)}
-    # The gait's keys (evorbc_ros.robots.legged.gait_from_settings).
-    return keys | {"oscillators", "joints", "gait.frequency_hz"}
+    # The gait's keys (evorbc_ros.robots.legged.gait_from_settings) and the records.
+    return keys | {"oscillators", "joints", "gait.frequency_hz", *legged_settings._RECORDS}
 
 
 def test_the_legged_page_documents_every_settings_key():

@@ -173,6 +173,9 @@ class _Top:
 
 #: Sections of a settings file (mappings), besides :class:`_Top`'s keys; tilt is optional.
 _SECTIONS = ("links", "oscillators", "joints", "gait", "servo", "physics", "tilt")
+#: Optional records the simulation does not read: how ``evorbc-evolve design-gait`` chose
+#: the gait design (docs/legged.md, "The gait design search").
+_RECORDS = ("design_search",)
 
 
 def _section(cls, values, source: str, key: str):
@@ -228,7 +231,11 @@ def robot_settings_from_mapping(data: dict, path: str | Path) -> LeggedRobotSett
     for key in _SECTIONS[:-1]:
         if key not in data:
             raise ConfigError(f"{source}: missing setting {key!r}")
-    top = build_settings(_Top, {k: v for k, v in data.items() if k not in _SECTIONS}, source)
+    for key in _RECORDS:
+        if key in data and not isinstance(data[key], dict):
+            raise ConfigError(f"{source}: {key}: expected a mapping")
+    top_keys = {k: v for k, v in data.items() if k not in _SECTIONS + _RECORDS}
+    top = build_settings(_Top, top_keys, source)
     servo = _section(_Servo, data["servo"], source, "servo")
     physics_file = _section(_Physics, data["physics"], source, "physics")
     tilt = _section(_Tilt, data.get("tilt", {}), source, "tilt")

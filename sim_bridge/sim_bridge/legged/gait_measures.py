@@ -1,0 +1,176 @@
+"""How well a legged robot's gait design walks: the measures the design search scores.
+
+The measures (docs/legged.md, "The gait design search"; docs/a1.md for how each was first
+used by hand):
+
+* **upright**: the share of random primitives (genes uniform in [-1, 1]) that never tilt
+  past the discard tilt in T = 2 s from rest, the repertoire's test (eq. 6);
+* **switching**: the share of episodes that do not fall over (tilt past the fallen tilt)
+  while the steady primitives (never past :data:`POOL_TILT`) are chained at random every
+  control cycle, 0.1 s, as an arbitrator may chain them;
+* **endpoint error**: the median distance (m) between where a primitive ends after T at
+  the design's physics rate and at a fine reference (1 kHz, 50 solver iterations), over
+  the primitives the reference keeps upright;
+* **reach**: the median distance (m) from the start after T of the upright primitives;
+* **cost**: CPU milliseconds of one process per T-second evaluation.
+
+Units: m, s, rad (deg where a name says so).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim_bridge.legged.evaluate import TILT, X, Y, evaluate_genes
+from sim_bridge.legged.physics import LeggedSim
+from sim_bridge.legged.settings import LeggedRobotSettings
+from sim_bridge.quiet_pybullet import p
+
+#: s, a primitive's evaluation time (the repertoire's T, paper Sec. V-B).
+T = 2.0
+#: rad: run every primitive the whole T so that endpoints compare.
+NO_EARLY_STOP = math.radians(180.0)
+#: The fine reference: physics Hz and solver iterations (docs/a1.md, "Physics rate").
+REFERENCE = (1000.0, 50)
+#: rad: primitives chained when switching never tilted past this in their T; circular+tilt
+#: quality keeps such steady primitives in a repertoire (docs/a1.md, "Gait design").
+POOL_TILT = math.radians(20.0)
+
+
+def with_physics(
+    settings: LeggedRobotSettings, rate: float, iterations: int | None = None
+) -> LeggedRobotSettings:
+    """``settings`` simulated at ``rate`` Hz (and ``iterations`` solver iterations)."""
+    iterations = settings.physics.solver_iterations if iterations is None else iterations
+    physics = dataclasses.replace(settings.physics, rate=rate, solver_iterations=iterations)
+    return dataclasses.replace(settings, physics=physics)
+
+
+def endpoint_errors(rows: np.ndarray, ref: np.ndarray, discard: float) -> np.ndarray:
+    """``(kept,)`` m: endpoint distances of outcome ``rows`` from the reference's.
+
+    Over the primitives the reference keeps upright (a fallen robot's endpoint is chaos).
+    """
+    kept = ref[:, TILT] <= discard
+    return np.hypot(rows[kept, X] - ref[kept, X], rows[kept, Y] - ref[kept, Y])
+
+
+def switching_episode(sim: LeggedSim, table, rows: np.ndarray, hold: int, fallen: float) -> bool:
+    """Run primitive ``rows[k // hold]`` of ``table`` in control cycle ``k``, from rest.
+
+    Each switch keeps the oscillators' clock (an arbitrator's switch, eq. 10).
+
+    Returns:
+        True if the robot fell over (tilted past ``fallen`` rad).
+
+    """
+    sim.reset()
+    steps = sim.physics.steps(sim.settings.control_period)
+    for cycle in range(len(rows) * hold):
+        row = rows[cycle // hold]
+        targets = table.joint_targets(sim.step_times(steps), np.full(steps, row))
+        tilt, _ = sim.run(targets, fallen)
+        if tilt > fallen:
+            return True
+    return False
+
+
+def joint_limits(settings: LeggedRobotSettings) -> tuple[np.ndarray, np.ndarray]:
+    """``(joints,)`` lower and upper limits (rad) of the actuated joints, in command order.
+
+    From the URDF's ``<limit>``; a joint without usable limits (continuous, or lower not
+    below upper) has ``-inf, inf``.
+    """
+    with LeggedSim(settings) as sim:
+        infos = [p.getJointInfo(sim.robot, j, physicsClientId=sim.client) for j in sim.joints]
+    low = np.array([i[8] if i[8] < i[9] else -np.inf for i in infos])
+    high = np.array([i[9] if i[8] < i[9] else np.inf for i in infos])
+    return low, high
+
+
+@dataclass(frozen=True)
+class DesignMeasures:
+    """A design's measures on one set of random primitives (see the module docstring)."""
+
+    upright: float  # share of primitives upright after T
+    switching: float  # share of switching episodes without a fall
+    endpoint_error: float  # m, median against the reference (inf: none to compare)
+    reach: float  # m, median distance after T of the upright primitives (0: none)
+    ms_per_evaluation: float  # CPU ms per T-second evaluation at the design's rate
+    steady: int  # primitives in the switching pool
+
+    def as_dict(self) -> dict:
+        """Plain data (JSON-safe; an infinite error is written as None)."""
+        d = dataclasses.asdict(self)
+        if not math.isfinite(d["endpoint_error"]):
+            d["endpoint_error"] = None
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> DesignMeasures:
+        """The inverse of :meth:`as_dict`."""
+        error = d["endpoint_error"]
+        return cls(**{**d, "endpoint_error": math.inf if error is None else error})
+
+
+def reference_rows(settings: LeggedRobotSettings, genes: np.ndarray) -> np.ndarray:
+    """``(n, 6)`` outcome rows of ``genes`` at the fine :data:`REFERENCE` physics, full T."""
+    with LeggedSim(with_physics(settings, *REFERENCE)) as sim:
+        return evaluate_genes(sim, genes, T, settings.control_period, NO_EARLY_STOP)
+
+
+def measure_design(
+    settings: LeggedRobotSettings,
+    genes: np.ndarray,
+    accuracy: int,
+    episodes: int,
+    episode_time: float,
+    seed: int,
+    reference: np.ndarray,
+) -> DesignMeasures:
+    """Measure one design on random primitives ``genes``.
+
+    Args:
+        settings: the design.
+        genes: ``(n, 1 + 3 k)`` primitives in [-1, 1]; the first ``accuracy`` run the
+            whole T (for the endpoint error and the cost), the others stop at the discard
+            tilt.
+        accuracy: how many of ``genes`` are compared with the reference.
+        episodes: switching episodes.
+        episode_time: s, each switching episode (a whole number of control periods).
+        seed: of the switching sequences.
+        reference: ``(accuracy, 6)`` rows of :func:`reference_rows` for ``genes[:accuracy]``.
+
+    """
+    period, discard = settings.control_period, settings.discard_tilt
+    with LeggedSim(settings) as sim:
+        start = time.process_time()
+        full = evaluate_genes(sim, genes[:accuracy], T, period, NO_EARLY_STOP)
+        cost = (time.process_time() - start) / max(accuracy, 1)
+        rest = evaluate_genes(sim, genes[accuracy:], T, period, discard)
+        rows = np.concatenate([full, rest])
+        upright = rows[:, TILT] <= discard
+        reach = np.hypot(rows[upright, X], rows[upright, Y])
+        steady = np.flatnonzero(rows[:, TILT] <= POOL_TILT)
+        falls = 0
+        if len(steady):
+            table = sim.gait_table(genes[steady])
+            rng = np.random.default_rng(seed)
+            cycles = round(episode_time / period)
+            for _ in range(episodes):
+                sequence = rng.integers(len(steady), size=cycles)
+                falls += switching_episode(sim, table, sequence, 1, settings.fallen_tilt)
+    errors = endpoint_errors(full, reference, discard)
+    return DesignMeasures(
+        upright=float(upright.mean()),
+        switching=(1.0 - falls / episodes) if len(steady) and episodes else 0.0,
+        endpoint_error=float(np.median(errors)) if len(errors) else math.inf,
+        reach=float(np.median(reach)) if len(reach) else 0.0,
+        ms_per_evaluation=1e3 * cost,
+        steady=len(steady),
+    )
