@@ -94,3 +94,23 @@ def test_bad_input_is_one_line(tmp_path):
     )  # fmt: skip
     assert result.returncode != 0 and "Traceback" not in result.stderr
     assert "arbitrator-runs.csv" in result.stderr
+
+
+def test_gzipped_tables_round_trip_and_refuse_a_bomb(tmp_path, monkeypatch):
+    from offline_evolution.results import tables
+
+    rows = [{"report": f"generalise/long-report-name-{k % 3}", "maze": k} for k in range(200)]
+    path = tmp_path / "t.csv.gz"
+    assert tables.write_table(path, ["report", "maze"], rows) == 200
+    first = path.read_bytes()
+    tables.write_table(path, ["report", "maze"], rows)
+    assert path.read_bytes() == first  # the same rows, the same bytes
+    back = tables.read_table(path, ["report", "maze"])
+    assert [r["maze"] for r in back] == [str(k) for k in range(200)]
+    monkeypatch.setattr(tables, "MAX_TABLE_BYTES", 1000)
+    with pytest.raises(TableError, match=r"t\.csv\.gz: more than 1000 bytes"):
+        tables.read_table(path)
+    broken = tmp_path / "b.csv.gz"
+    broken.write_bytes(b"not gzip at all")
+    with pytest.raises(TableError, match=r"b\.csv\.gz: cannot read the table"):
+        tables.read_table(broken)

@@ -183,7 +183,7 @@ def shared_histories(runs: list[tuple[str, dict]]) -> dict[str, str]:
 
 
 def report_rows(name: str, report: dict, root: str = "") -> tuple[dict, list[dict]]:
-    """A report's row of ``evaluation-reports.csv`` and its rows of ``evaluation-mazes.csv``.
+    """A report's row of ``evaluation-reports.csv`` and its rows of ``evaluation-mazes.csv.gz``.
 
     ``failed_stalled`` (episodes that stalled and did not reach the target) is counted from
     the episodes when the report holds them, else taken from the per-maze rows if there.
@@ -291,11 +291,11 @@ def extract(root: Path, out: Path, controllers: Iterable[str] = ()) -> dict[str,
         "evaluation-reports.csv": write_table(
             out / "evaluation-reports.csv", REPORT_COLUMNS, (head for head, _ in reports)
         ),
-        "evaluation-mazes.csv": write_table(
-            out / "evaluation-mazes.csv", MAZE_COLUMNS, (r for _, rows in reports for r in rows)
+        "evaluation-mazes.csv.gz": write_table(
+            out / "evaluation-mazes.csv.gz", MAZE_COLUMNS, (r for _, rows in reports for r in rows)
         ),
-        "candidates.csv": write_table(
-            out / "candidates.csv",
+        "candidates.csv.gz": write_table(
+            out / "candidates.csv.gz",
             CANDIDATE_COLUMNS,
             (r for n, d in found["candidates"] for r in candidate_rows(n, d)),
         ),

@@ -19,7 +19,7 @@ KINDS = ("baffle", "gap", "diagonal", "posts", "block", "dead_end", "chamber")
 def load_results(results: Path) -> tuple[dict[str, dict], dict[str, list[dict]]]:
     """The runs by name and each report's per-maze rows (the ``all`` row last)."""
     runs_path = results / "arbitrator-runs.csv"
-    mazes_path = results / "evaluation-mazes.csv"
+    mazes_path = results / "evaluation-mazes.csv.gz"
     runs = {r["run"]: r for r in read_table(runs_path, ("run", "post_reached", "post_episodes"))}
     reports: dict[str, list[dict]] = {}
     for row in read_table(mazes_path, ("report", "maze", "episodes", "reached")):
@@ -84,7 +84,7 @@ def screening_table(results: Path, prefix: str = "generalise/") -> str:
             continue
         heldr = _rate(overall(reports, f"{name}.heldr"))
         post = number(run, "post_reached", results / "arbitrator-runs.csv")
-        fitness = number(held, "mean_fitness", results / "evaluation-mazes.csv")
+        fitness = number(held, "mean_fitness", results / "evaluation-mazes.csv.gz")
         lines.append(
             f"| {name[len(prefix) :]} | {training(run)} | {_rate(paper):.0%} | "
             f"**{_rate(held):.1%}** | {'' if heldr is None else f'{heldr:.1%}'} | "
@@ -100,7 +100,7 @@ def report_lines(results: Path, names: list[str]) -> str:
     Also the failures that stalled (the breakdowns "paper-seeds" and "heldout-one-at-a-time").
 
     Raises:
-        TableError: a report is not in ``evaluation-mazes.csv``.
+        TableError: a report is not in ``evaluation-mazes.csv.gz``.
     """
     _, reports = load_results(results)
     lines = [
@@ -110,7 +110,7 @@ def report_lines(results: Path, names: list[str]) -> str:
     for name in names:
         o = overall(reports, name)
         if o is None:
-            raise TableError(f"{results / 'evaluation-mazes.csv'}: no report {name}")
+            raise TableError(f"{results / 'evaluation-mazes.csv.gz'}: no report {name}")
         episodes, reached = int(o["episodes"]), int(o["reached"])
         stalled = o["failed_stalled"] or "?"
         lines.append(
@@ -153,7 +153,7 @@ def kinds_table(results: Path, mazes_json: Path, names: list[str]) -> str:
         for name in names:
             rows = [r for r in reports.get(name, []) if r["maze"] != "all"]
             if not rows:
-                raise TableError(f"{results / 'evaluation-mazes.csv'}: no report {name}")
+                raise TableError(f"{results / 'evaluation-mazes.csv.gz'}: no report {name}")
             missing = [r["maze"] for r in rows if r["maze"] not in mazes]
             if missing:
                 raise TableError(f"{mazes_json}: mazes of {name} not in it: {missing[:3]}")

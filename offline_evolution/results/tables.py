@@ -2,18 +2,25 @@
 
 Numbers are written with 4 significant digits: the tables feed summary tables and curves
 that print 2-3 digits, and the full precision of every run stays in the commit named in
-docs/results/README.md.
+docs/results/README.md. A table whose name ends in ``.csv.gz`` is the same CSV gzipped
+(the two largest: their rows repeat long report and run names, a tenth of the bytes
+gzipped); reading one stops at :data:`MAX_TABLE_BYTES` of text, so a hostile file cannot
+fill memory.
 """
 
 from __future__ import annotations
 
 import csv
+import gzip
 import io
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
-from evorbc_ros.atomic_io import atomic_write_text
+from evorbc_ros.atomic_io import atomic_write, atomic_write_text
+
+#: Bytes of CSV text a gzipped table may hold (the largest holds 0.5 MB).
+MAX_TABLE_BYTES = 64 * 2**20
 
 
 def cell(value) -> str:
@@ -36,7 +43,12 @@ def write_table(path: str | os.PathLike, columns: Sequence[str], rows: Iterable[
     for row in rows:
         out.writerow([cell(row.get(c)) for c in columns])
         n += 1
-    atomic_write_text(path, buf.getvalue())
+    if str(path).endswith(".gz"):
+        # mtime 0: the same rows give the same bytes, so an unchanged table is no change
+        data = gzip.compress(buf.getvalue().encode(), compresslevel=9, mtime=0)
+        atomic_write(path, lambda f: f.write(data), binary=True)
+    else:
+        atomic_write_text(path, buf.getvalue())
     return n
 
 
@@ -52,16 +64,28 @@ def read_table(path: str | os.PathLike, needed: Sequence[str] = ()) -> list[dict
     """
     path = Path(path)
     try:
-        with path.open(newline="") as f:
-            reader = csv.DictReader(f)
-            rows = list(reader)
-            header = reader.fieldnames or []
-    except (OSError, UnicodeDecodeError, csv.Error) as e:
+        text = _text(path)
+        reader = csv.DictReader(io.StringIO(text, newline=""))
+        rows = list(reader)
+        header = reader.fieldnames or []
+    except (OSError, EOFError, gzip.BadGzipFile, UnicodeDecodeError, csv.Error) as e:
         raise TableError(f"{path}: cannot read the table ({e})") from None
     missing = [c for c in needed if c not in header]
     if missing:
         raise TableError(f"{path}: expected columns {', '.join(missing)} in the header row")
     return rows
+
+
+def _text(path: Path) -> str:
+    """The CSV text of ``path``, gunzipped if its name ends in ``.gz`` (bounded)."""
+    if not str(path).endswith(".gz"):
+        with path.open(newline="") as f:
+            return f.read()
+    with gzip.open(path, "rb") as f:
+        data = f.read(MAX_TABLE_BYTES + 1)
+    if len(data) > MAX_TABLE_BYTES:
+        raise TableError(f"{path}: more than {MAX_TABLE_BYTES} bytes of CSV; expected a table")
+    return data.decode()
 
 
 def number(row: Mapping[str, str], key: str, path: str | os.PathLike = "") -> float | None:
