@@ -28,15 +28,20 @@ class AdaptationSettings:
         length_scale: the kernel's reach over the outcome space, as a fraction of the
             repertoire's extent in each of ``dx``, ``dy`` and ``dheading`` (unitless).
         noise: observation noise variance over the prior variance (unitless, > 0).
-        settle_cycles: a cycle is observed only after the primitive ran this many cycles
-            before it, so that the actuators reached its command.
+        settle_cycles: a cycle is observed only after the primitive ran at least this many
+            cycles before it, so that the actuators could reach its command.
+        steady_tolerance: and only if its motion, extended to ``T``, is within this
+            fraction of the repertoire's extent of the cycle before's (position, and
+            heading over its extent): the actuators have settled (unitless). A cycle that
+            translates less than that over ``T`` is not observed.
         window: settled cycles summed into one observation (at most; a switch ends it).
     """
 
     capacity: int = 32
     length_scale: float = 0.5
     noise: float = 0.05
-    settle_cycles: int = 5
+    settle_cycles: int = 1
+    steady_tolerance: float = 0.02
     window: int = 5
 
     def __post_init__(self) -> None:
@@ -45,6 +50,7 @@ class AdaptationSettings:
             ("length_scale", 0.0 < self.length_scale <= 10.0, "in (0, 10]"),
             ("noise", 0.0 < self.noise <= 100.0, "in (0, 100]"),
             ("settle_cycles", 0 <= self.settle_cycles <= 1000, "between 0 and 1000"),
+            ("steady_tolerance", 0.0 <= self.steady_tolerance <= 10.0, "in [0, 10]"),
             ("window", 1 <= self.window <= 1000, "between 1 and 1000"),
         )
         for name, ok, what in checks:

@@ -42,6 +42,10 @@ class OnlineAdaptation:
         self.settings = settings or AdaptationSettings()
         self.model = OutcomeModel(recorded, self.settings, expected)
         self.horizon = horizon
+        extent = self.model.recorded.max(axis=0) - self.model.recorded.min(axis=0)
+        tol = self.settings.steady_tolerance
+        #: m and rad over T: how far a cycle's extended motion may be from the last one's.
+        self.tolerance = (tol * float(max(extent[0], extent[1])), tol * float(extent[2]))
         self.reset()
 
     def reset(self) -> None:
@@ -54,6 +58,7 @@ class OnlineAdaptation:
         self.running = -1  # the primitive chosen at the last choice (-1: none)
         self.held = 0  # consecutive choices of it, the last included
         self.anchor: tuple[int, float, float, float] | None = None  # pose at the last choice
+        self.last: tuple[float, float, float] | None = None  # last cycle's motion over T
         self._clear_sum()
 
     def _clear_sum(self) -> None:
@@ -75,13 +80,35 @@ class OnlineAdaptation:
             self._flush()
             self._clear_run()
             return
-        if self.held > self.settings.settle_cycles:
-            step = relative_motion(anchor[1], anchor[2], anchor[3], pose[1], pose[2], pose[3])
+        step = relative_motion(anchor[1], anchor[2], anchor[3], pose[1], pose[2], pose[3])
+        seen = extend_arc(*step, (pose[0] - anchor[0]) * 1e-9, self.horizon)
+        last, self.last = self.last, seen
+        if (
+            self.held > self.settings.settle_cycles
+            and last is not None
+            and self._steady(last, seen)
+        ):
             self.summed = compose(*self.summed, *step)
             self.summed_ns += pose[0] - anchor[0]
             self.summed_cycles += 1
             if self.summed_cycles >= self.settings.window:
                 self._flush()
+        else:
+            self._flush()  # what was summed is settled; this cycle is not
+
+    def _steady(self, a: tuple, b: tuple) -> bool:
+        """Whether cycle ``b`` translated and agrees with cycle ``a`` within the tolerance.
+
+        Two cycles without translation agree, but tell nothing: wheels that fight while
+        they turn towards a command stop the 4WS body for a cycle or two, and a wall keeps
+        the position (every 4WS primitive that moves translates).
+        """
+        pos, head = self.tolerance
+        return (
+            math.hypot(b[0], b[1]) > pos
+            and math.hypot(a[0] - b[0], a[1] - b[1]) <= pos
+            and abs(a[2] - b[2]) <= head
+        )
 
     def after_choice(self, index: int) -> None:
         """The primitive chosen now (``-1``: none, the robot stops)."""
@@ -89,6 +116,7 @@ class OnlineAdaptation:
             self._flush()
             self.running = index
             self.held = 0
+            self.last = None
         self.held = self.held + 1 if index >= 0 else 0
         self.anchor = self.pose
 
