@@ -115,12 +115,17 @@ def hold_lengths(rep: Repertoire) -> np.ndarray:
     return np.array(held)
 
 
+def arguments(doc: str, count: str, default: int) -> argparse.Namespace:
+    """The command line: ``--<count> N`` (episodes or pairs) and ``--seed``."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument(f"--{count}", type=int, default=default)
+    parser.add_argument("--seed", type=int, default=1)
+    return parser.parse_args()
+
+
 def main() -> None:
     """Print the tables."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--pairs", type=int, default=2000)
-    parser.add_argument("--seed", type=int, default=1)
-    args = parser.parse_args()
+    args = arguments(__doc__, "pairs", 2000)
     rep = Repertoire.load(default_repertoire("4ws-5"))
     robot = FourWSRobot("4ws-5")
     tau = float(np.max(np.hypot(rep.behaviour[:, 0], rep.behaviour[:, 1])))

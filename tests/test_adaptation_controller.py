@@ -68,6 +68,19 @@ def test_off_by_default_and_on_without_poses_chooses_as_evolved(inputs):
     assert intact.adaptation_state()["mean correction m"] < 1e-3
 
 
+def test_observations_without_correction_choose_as_the_grid():
+    """Matched at cell centres: with corrections of 0 the choices are the grid's, exactly."""
+    off, on = Controller(), Controller()
+    on.enable_adaptation()
+    model = on.adaptation.model
+    for i in range(0, len(model), 3):
+        model.observe(i, model.expected[i])  # what was expected: no correction
+    assert model.used == 32 and not model.correction.any()
+    rng = np.random.default_rng(8)
+    rows = rng.uniform(0, 1, (400, off.spec.sensors.n_inputs))
+    assert same(run(on, rows), run(off, rows))
+
+
 def test_a_damaged_robot_is_corrected_and_reset_forgets(inputs):
     plain = run(Controller(), inputs)
     c = Controller()

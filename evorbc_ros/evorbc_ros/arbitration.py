@@ -168,7 +168,11 @@ class Controller:
         index, m, x, y = self.arbitrator.choose_point(inputs)
         if self.adaptation is not None:
             self.adaptation.before_choice()
-            index = self.adaptation.choose(x, y, index)
+            if index != NO_PRIMITIVE:
+                # Matched at the grid cell's centre, as the grid was filled: with no
+                # correction the choice is the grid's, bit for bit (docs/design.md
+                # section 24).
+                index = self.adaptation.choose(*self.arbitrator.lookup.cell_centre(x, y), index)
             self.adaptation.after_choice(index)
         self.last_index = index
         row = [float(m[0]), float(m[1]), x, y, float(index)]

@@ -128,10 +128,13 @@ class OnlineAdaptation:
         self._clear_sum()
 
     def choose(self, x: float, y: float, looked_up: int) -> int:
-        """The primitive to run for the mapping's point ``(x, y)`` (m).
+        """The primitive whose corrected ``(dx, dy)`` is nearest the point ``(x, y)`` (m).
 
         ``looked_up`` is the repertoire's lookup-grid answer, which stands while there is
-        no observation (so an adapting controller starts exactly as the evolved one).
+        no observation (so an adapting controller starts exactly as the evolved one). The
+        controller passes the centre of the grid cell of the mapping's point, where the
+        grid holds the brute-force nearest: where no primitive is corrected, the answer
+        is the grid's.
         """
         if self.model.used == 0 or looked_up < 0:
             return looked_up
