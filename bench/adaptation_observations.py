@@ -115,11 +115,13 @@ def hold_lengths(rep: Repertoire) -> np.ndarray:
     return np.array(held)
 
 
-def arguments(doc: str, count: str, default: int) -> argparse.Namespace:
-    """The command line: ``--<count> N`` (episodes or pairs) and ``--seed``."""
+def arguments(doc: str, count: str, default: int, **floats: float) -> argparse.Namespace:
+    """The command line: ``--<count> N`` (episodes or pairs), ``--seed`` and ``floats``."""
     parser = argparse.ArgumentParser(description=doc.splitlines()[0])
     parser.add_argument(f"--{count}", type=int, default=default)
     parser.add_argument("--seed", type=int, default=1)
+    for name, value in floats.items():
+        parser.add_argument(f"--{name}", type=float, default=value)
     return parser.parse_args()
 
 

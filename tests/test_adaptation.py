@@ -95,6 +95,7 @@ def test_compiled_functions_give_the_same_bits(recorded):
     assert np.array_equal(plain.corrected, jitted.corrected)
     assert plain.uncertainty(int(rows[-1])) == jitted.uncertainty(int(rows[-1]))
     assert plain.nearest(0.1, 0.05) == jitted.nearest(0.1, 0.05)
+    assert plain.nearest_outcome(7) == jitted.nearest_outcome(7)
 
 
 def test_turning_twenty_percent_less_is_learned(recorded):
@@ -183,3 +184,5 @@ def test_settings_are_checked():
         AdaptationSettings(capacity=0)
     with pytest.raises(ValueError, match="adaptation noise must be"):
         AdaptationSettings(noise=0.0)
+    with pytest.raises(ValueError, match="adaptation match must be one of point, outcome"):
+        AdaptationSettings(match="nearest")

@@ -7,6 +7,8 @@ import pytest
 from test_adaptation import turning_less
 from test_nonfinite_outputs import standard_controller_file
 
+from evorbc_ros.adaptation import AdaptationSettings
+from evorbc_ros.adaptation.model import MATCHES
 from evorbc_ros.adaptation.motion import extend_arc
 from evorbc_ros.arbitration import Controller
 from evorbc_ros.mapping import NO_PRIMITIVE
@@ -68,10 +70,15 @@ def test_off_by_default_and_on_without_poses_chooses_as_evolved(inputs):
     assert intact.adaptation_state()["mean correction m"] < 1e-3
 
 
-def test_observations_without_correction_choose_as_the_grid():
-    """Matched at cell centres: with corrections of 0 the choices are the grid's, exactly."""
+@pytest.mark.parametrize("match", MATCHES)
+def test_observations_without_correction_choose_as_the_grid(match):
+    """With corrections of 0 the choices are the grid's, exactly, with either matching.
+
+    ``point`` matches at the grid cell's centre, where the grid holds the brute-force
+    nearest; ``outcome`` finds the grid's own choice at distance 0.
+    """
     off, on = Controller(), Controller()
-    on.enable_adaptation()
+    on.enable_adaptation(AdaptationSettings(match=match))
     model = on.adaptation.model
     for i in range(0, len(model), 3):
         model.observe(i, model.expected[i])  # what was expected: no correction
@@ -81,10 +88,11 @@ def test_observations_without_correction_choose_as_the_grid():
     assert same(run(on, rows), run(off, rows))
 
 
-def test_a_damaged_robot_is_corrected_and_reset_forgets(inputs):
+@pytest.mark.parametrize("match", MATCHES)
+def test_a_damaged_robot_is_corrected_and_reset_forgets(inputs, match):
     plain = run(Controller(), inputs)
     c = Controller()
-    c.enable_adaptation()
+    c.enable_adaptation(AdaptationSettings(match=match))
     damaged = run(c, inputs, factor=0.5)
     state = c.adaptation_state()
     assert state["observations"] >= 10
@@ -92,7 +100,7 @@ def test_a_damaged_robot_is_corrected_and_reset_forgets(inputs):
     assert 0.0 <= state["uncertainty"] < 1.0
     assert not same(damaged, plain)  # the choices changed
     again = Controller()
-    again.enable_adaptation()
+    again.enable_adaptation(AdaptationSettings(match=match))
     assert same(run(again, inputs, factor=0.5), damaged)  # deterministic
     c.reset_adaptation()
     c.reset()

@@ -129,6 +129,18 @@ def nearest(points: np.ndarray, x: float, y: float) -> int:
     return int(np.argmin(ex * ex + ey * ey))
 
 
+def nearest_outcome(outcomes: np.ndarray, target: np.ndarray, weight: np.ndarray) -> int:
+    """Row of the ``(n, 3)`` ``outcomes`` nearest ``target`` ``(3,)``, in ``weight`` units.
+
+    The distance is ``sum_c ((outcomes[:, c] - target[c]) * weight[c])^2`` (``weight``:
+    1 / m, 1 / m, 1 / rad); ties go to the lower row.
+    """
+    e0 = (outcomes[:, 0] - target[0]) * weight[0]
+    e1 = (outcomes[:, 1] - target[1]) * weight[1]
+    e2 = (outcomes[:, 2] - target[2]) * weight[2]
+    return int(np.argmin(e0 * e0 + e1 * e1 + e2 * e2))
+
+
 #: The functions above, callees first (each may call only those before it).
 FUNCTIONS = (
     "wendland",
@@ -137,6 +149,7 @@ FUNCTIONS = (
     "refit",
     "variance",
     "nearest",
+    "nearest_outcome",
 )
 
 

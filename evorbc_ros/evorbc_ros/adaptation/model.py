@@ -17,6 +17,8 @@ from evorbc_ros.adaptation import gp
 
 #: Bounds of :class:`AdaptationSettings` ``capacity``: observations kept.
 MAX_CAPACITY = 256
+#: How the network's choice is matched against the corrected outcomes.
+MATCHES = ("point", "outcome")
 
 
 @dataclass(frozen=True)
@@ -35,6 +37,10 @@ class AdaptationSettings:
             heading over its extent): the actuators have settled (unitless). A cycle that
             translates less than that over ``T`` is not observed.
         window: settled cycles summed into one observation (at most; a switch ends it).
+        match: ``point``: the primitive whose corrected ``(dx, dy)`` is nearest the
+            mapping's point; ``outcome``: the one whose corrected outcome is nearest the
+            recorded outcome of the primitive the grid chose (what the network asked for),
+            each dimension over the repertoire's extent in it.
     """
 
     capacity: int = 32
@@ -43,6 +49,7 @@ class AdaptationSettings:
     settle_cycles: int = 1
     steady_tolerance: float = 0.02
     window: int = 5
+    match: str = "point"
 
     def __post_init__(self) -> None:
         checks = (
@@ -53,6 +60,8 @@ class AdaptationSettings:
             ("steady_tolerance", 0.0 <= self.steady_tolerance <= 10.0, "in [0, 10]"),
             ("window", 1 <= self.window <= 1000, "between 1 and 1000"),
         )
+        if self.match not in MATCHES:
+            raise ValueError(f"adaptation match must be one of {', '.join(MATCHES)}")
         for name, ok, what in checks:
             if not ok:
                 raise ValueError(f"adaptation {name} must be {what}, got {getattr(self, name)!r}")
@@ -100,6 +109,8 @@ class OutcomeModel:
         if self.recorded.shape != (n, 3) or self.expected.shape != (n, 3):
             raise ValueError(f"outcomes must be (n, 3) arrays, got {self.expected.shape}")
         self.features = scaled_features(self.recorded, settings.length_scale)
+        extent = self.recorded.max(axis=0) - self.recorded.min(axis=0)
+        self.weight = np.where(extent > 0.0, 1.0 / np.where(extent > 0.0, extent, 1.0), 1.0)
         k = settings.capacity
         self.kzx = np.zeros((k, n))
         self.slots = np.full(k, -1, dtype=np.int64)
@@ -156,6 +167,13 @@ class OutcomeModel:
     def nearest(self, x: float, y: float) -> int:
         """The primitive whose corrected ``(dx, dy)`` is nearest the point ``(x, y)`` (m)."""
         return self.gp["nearest"](self.corrected, x, y)
+
+    def nearest_outcome(self, index: int) -> int:
+        """The primitive whose corrected outcome is nearest ``index``'s recorded one.
+
+        Each dimension is measured over the repertoire's extent in it (unitless).
+        """
+        return self.gp["nearest_outcome"](self.corrected, self.recorded[index], self.weight)
 
     def uncertainty(self, index: int) -> float:
         """Primitive ``index``'s posterior variance over the prior's (1 with no observation)."""

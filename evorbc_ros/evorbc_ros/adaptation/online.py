@@ -138,4 +138,6 @@ class OnlineAdaptation:
         """
         if self.model.used == 0 or looked_up < 0:
             return looked_up
+        if self.settings.match == "outcome":
+            return self.model.nearest_outcome(looked_up)
         return self.model.nearest(x, y)
