@@ -184,5 +184,5 @@ def test_settings_are_checked():
         AdaptationSettings(capacity=0)
     with pytest.raises(ValueError, match="adaptation noise must be"):
         AdaptationSettings(noise=0.0)
-    with pytest.raises(ValueError, match="adaptation match must be one of point, outcome"):
+    with pytest.raises(ValueError, match="adaptation match must be one of outcome, point"):
         AdaptationSettings(match="nearest")

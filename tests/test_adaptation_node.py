@@ -66,8 +66,11 @@ def test_adaptation_parameter_odometry_reset_and_diagnostics(ros):
         ]
         return found and "adaptation: observations" in found[-1] and found[-1]
 
-    assert ros.spin_until(reported, timeout=5.0)
-    assert int(reported()["adaptation: observations"]) >= 1
+    def observed():  # a report made after the observations (earlier ones may come first)
+        last = reported()
+        return bool(last) and int(last["adaptation: observations"]) >= 1
+
+    assert ros.spin_until(observed, timeout=5.0)
     assert float(reported()["adaptation: uncertainty"]) < 1.0
 
     client = ros.helper.create_client(Empty, "/arbitrator/reset_adaptation")

@@ -18,7 +18,7 @@ from evorbc_ros.adaptation import gp
 #: Bounds of :class:`AdaptationSettings` ``capacity``: observations kept.
 MAX_CAPACITY = 256
 #: How the network's choice is matched against the corrected outcomes.
-MATCHES = ("point", "outcome")
+MATCHES = ("outcome", "point")
 
 
 @dataclass(frozen=True)
@@ -37,10 +37,11 @@ class AdaptationSettings:
             heading over its extent): the actuators have settled (unitless). A cycle that
             translates less than that over ``T`` is not observed.
         window: settled cycles summed into one observation (at most; a switch ends it).
-        match: ``point``: the primitive whose corrected ``(dx, dy)`` is nearest the
-            mapping's point; ``outcome``: the one whose corrected outcome is nearest the
-            recorded outcome of the primitive the grid chose (what the network asked for),
-            each dimension over the repertoire's extent in it.
+        match: ``outcome``: the primitive whose corrected outcome is nearest the
+            recorded outcome of the primitive the grid chose (what the network asked
+            for), each dimension over the repertoire's extent in it; ``point``: the one
+            whose corrected ``(dx, dy)`` is nearest the mapping's point (measured to fail
+            on a mismatched robot: docs/design.md section 24).
     """
 
     capacity: int = 32
@@ -49,7 +50,7 @@ class AdaptationSettings:
     settle_cycles: int = 1
     steady_tolerance: float = 0.02
     window: int = 5
-    match: str = "point"
+    match: str = "outcome"
 
     def __post_init__(self) -> None:
         checks = (
