@@ -6,7 +6,7 @@ lockstep simulation each choice uses the readings of one instant.
 
 An EvoRBC controller may adapt (off unless :meth:`Controller.enable_adaptation` is
 called): it is then fed odometry poses (:meth:`Controller.put_pose`) and matches the
-mapping's point against corrected outcomes (docs/design.md section 24).
+network's choice against corrected outcomes (docs/design.md section 24).
 """
 
 from __future__ import annotations
@@ -169,9 +169,9 @@ class Controller:
         if self.adaptation is not None:
             self.adaptation.before_choice()
             if index != NO_PRIMITIVE:
-                # Matched at the grid cell's centre, as the grid was filled: with no
-                # correction the choice is the grid's, bit for bit (docs/design.md
-                # section 24).
+                # The grid's choice, and the centre of its cell, where the grid holds the
+                # brute-force nearest: with no correction either rule chooses as the
+                # grid, bit for bit (docs/design.md section 24).
                 index = self.adaptation.choose(*self.arbitrator.lookup.cell_centre(x, y), index)
             self.adaptation.after_choice(index)
         self.last_index = index

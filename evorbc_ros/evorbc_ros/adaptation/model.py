@@ -3,7 +3,7 @@
 The repertoire's recorded outcomes are the prior: what each primitive does over the
 evaluation time ``T`` (``(dx m, dy m, dheading rad)`` in its start frame). Observations of
 what an executed primitive actually did correct it through a Gaussian process
-(:mod:`evorbc_ros.adaptation.gp`), and the mapping's target point is matched against the
+(:mod:`evorbc_ros.adaptation.gp`), and the network's choice is matched against the
 corrected outcomes, so the arbitrator network runs as evolved (docs/design.md section 24).
 """
 

@@ -17,9 +17,9 @@ expected displacement on ``~/markers`` (:mod:`evorbc_ros.nodes.managed`).
 
 With ``adaptation`` (off by default; applied live, and false forgets what was learned)
 the node also subscribes ``odom`` (nav_msgs/Odometry, sensor-data QoS: the radar node's
-odometry), chooses once a new pose has come with the readings, and matches the mapping's
-point against the primitives' outcomes corrected from what they did (docs/design.md
-section 24). ``~/reset_adaptation`` (std_srvs/Empty) forgets the observations. Its state
+odometry), chooses once a new pose has come with the readings, and runs the primitive
+whose outcome, corrected from what the primitives did, is nearest what the network's
+choice was recorded to do (docs/design.md section 24). ``~/reset_adaptation`` (std_srvs/Empty) forgets the observations. Its state
 is in the health report, and the chosen primitive's corrected displacement in the
 markers.
 """
