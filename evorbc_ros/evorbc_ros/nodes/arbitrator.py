@@ -19,9 +19,9 @@ With ``adaptation`` (off by default; applied live, and false forgets what was le
 the node also subscribes ``odom`` (nav_msgs/Odometry, sensor-data QoS: the radar node's
 odometry), chooses once a new pose has come with the readings, and runs the primitive
 whose outcome, corrected from what the primitives did, is nearest what the network's
-choice was recorded to do (docs/design.md section 24). ``~/reset_adaptation`` (std_srvs/Empty) forgets the observations. Its state
-is in the health report, and the chosen primitive's corrected displacement in the
-markers.
+choice was recorded to do (docs/design.md section 24). ``~/reset_adaptation``
+(std_srvs/Empty) forgets the observations. Its state is in the health report, and the
+chosen primitive's corrected displacement in the markers.
 """
 
 from __future__ import annotations
