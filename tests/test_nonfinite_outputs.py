@@ -104,7 +104,8 @@ def test_the_onboard_controller_chooses_no_primitive_and_does_not_raise(tmp_path
     assert "not finite" in reason and "the robot stops" in reason
 
 
-def test_a_standard_controller_with_non_finite_outputs_runs_no_genes(tmp_path):
+def standard_controller_file(tmp_path):
+    """The shipped 4ws-5 arbitrator made a standard-NEAT one (5 outputs); its data, path."""
     data = json.loads(json.dumps(ARB))
     data.update(kind="standard", parameters=[p.as_dict() for p in Repertoire.load(
         default_repertoire()).parameters])  # fmt: skip
@@ -114,6 +115,11 @@ def test_a_standard_controller_with_non_finite_outputs_runs_no_genes(tmp_path):
     net["nodes"] += [dict(net["nodes"][0], key=k) for k in (2, 3, 4)]
     path = tmp_path / "standard.json"
     path.write_text(json.dumps(data))
+    return data, path
+
+
+def test_a_standard_controller_with_non_finite_outputs_runs_no_genes(tmp_path):
+    data, path = standard_controller_file(tmp_path)
     controller = Controller(str(path))
     inputs = np.full(10, 0.5)
     genes, row = controller.step(inputs)

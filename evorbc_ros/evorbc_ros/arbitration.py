@@ -3,12 +3,17 @@
 Inputs come in groups (rangefinder readings, goal readings) on separate topics. A choice
 is made once every group has delivered a new message since the previous choice, so in a
 lockstep simulation each choice uses the readings of one instant.
+
+An EvoRBC controller may adapt (off unless :meth:`Controller.enable_adaptation` is
+called): it is then fed odometry poses (:meth:`Controller.put_pose`) and matches the
+network's choice against corrected outcomes (docs/design.md section 24).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from evorbc_ros.adaptation import AdaptationSettings, OnlineAdaptation, outcome_table
 from evorbc_ros.arbitrator import Arbitrator, ArbitratorFile, DirectController
 from evorbc_ros.defaults import default_arbitrator, default_repertoire
 from evorbc_ros.laser import InputError
@@ -60,6 +65,10 @@ class Controller:
         else:
             self.repertoire_path = ""
             self.direct = DirectController(self.spec)
+        #: The online outcome model, or None: adaptation is off (the default).
+        self.adaptation: OnlineAdaptation | None = None
+        #: Primitive chosen by the last step (-1: none yet, or none that cycle).
+        self.last_index = -1
 
     @property
     def recurrent(self) -> bool:
@@ -67,8 +76,70 @@ class Controller:
         return self.spec.network.recurrent
 
     def reset(self) -> None:
-        """Start an episode: a recurrent network's state back to 0 (no-op if feed-forward)."""
+        """Start an episode: a recurrent network's state back to 0 (no-op if feed-forward).
+
+        What adaptation learned is kept (the robot is the same robot for a new goal);
+        :meth:`reset_adaptation` forgets it.
+        """
         (self.arbitrator if self.repertoire is not None else self.direct).reset()
+
+    def enable_adaptation(
+        self, settings: AdaptationSettings | None = None, expected: np.ndarray | None = None
+    ) -> None:
+        """Start adapting, from the prior (docs/design.md section 24).
+
+        Args:
+            settings: the model's; default :class:`AdaptationSettings`.
+            expected: ``(n, 3)`` what each primitive's settled cycles should read on the
+                robot the repertoire was made on, over its evaluation time ``(dx m, dy m,
+                dheading rad)``; default the recorded outcomes.
+
+        Raises:
+            ValueError: a standard-NEAT controller (it has no primitives to correct).
+        """
+        if self.repertoire is None:
+            raise ValueError("adaptation needs an EvoRBC controller (with a repertoire)")
+        rep = self.repertoire
+        recorded = outcome_table(rep.behaviour, rep.heading)
+        self.adaptation = OnlineAdaptation(recorded, rep.eval_time, settings, expected)
+
+    def disable_adaptation(self) -> None:
+        """Stop adapting and forget what was learned: choices are the evolved ones again."""
+        self.adaptation = None
+
+    def reset_adaptation(self) -> None:
+        """Forget every observation: the corrected outcomes are the recorded ones again."""
+        if self.adaptation is not None:
+            self.adaptation.reset()
+
+    def put_pose(self, stamp_ns: int, x: float, y: float, yaw: float) -> None:
+        """The newest odometry pose: ``(x m, y m)`` and ``yaw`` (rad) in its fixed frame.
+
+        Ignored while adaptation is off. The next :meth:`step` attributes the motion since
+        the last step to the primitive chosen then.
+        """
+        if self.adaptation is not None:
+            self.adaptation.put_pose(stamp_ns, x, y, yaw)
+
+    def adaptation_state(self) -> dict[str, float | int]:
+        """What adaptation knows, for diagnostics ({} while off).
+
+        ``observations`` (taken since the reset), ``primitives observed`` (in the model),
+        ``mean correction m`` and ``mean heading correction rad`` (over every primitive),
+        ``uncertainty`` of the last chosen primitive (posterior variance over the prior's:
+        1 unknown, 0 certain).
+        """
+        a = self.adaptation
+        if a is None:
+            return {}
+        move, turn = a.model.mean_correction()
+        return {
+            "observations": a.model.observations,
+            "primitives observed": a.model.used,
+            "mean correction m": move,
+            "mean heading correction rad": turn,
+            "uncertainty": a.model.uncertainty(self.last_index),
+        }
 
     @property
     def parameter_names(self) -> list[str]:
@@ -95,6 +166,15 @@ class Controller:
             genes = self.direct.genes(inputs)
             return (np.empty(0) if genes is None else genes), []
         index, m, x, y = self.arbitrator.choose_point(inputs)
+        if self.adaptation is not None:
+            self.adaptation.before_choice()
+            if index != NO_PRIMITIVE:
+                # The grid's choice, and the centre of its cell, where the grid holds the
+                # brute-force nearest: with no correction either rule chooses as the
+                # grid, bit for bit (docs/design.md section 24).
+                index = self.adaptation.choose(*self.arbitrator.lookup.cell_centre(x, y), index)
+            self.adaptation.after_choice(index)
+        self.last_index = index
         row = [float(m[0]), float(m[1]), x, y, float(index)]
         if index == NO_PRIMITIVE:
             return np.empty(0), row

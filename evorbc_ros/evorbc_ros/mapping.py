@@ -123,6 +123,14 @@ class PrimitiveLookup:
             clamped_cell((y - self.origin[1]) / self.cell[1], ny),
         )
 
+    def cell_centre(self, x: float, y: float) -> tuple[float, float]:
+        """The centre of the cell of ``(x, y)`` (m), computed as :meth:`build` computes it.
+
+        The primitive nearest it by brute force is the table's entry, bit for bit.
+        """
+        i, j = self.cell_of(x, y)
+        return self.origin[0] + (i + 0.5) * self.cell[0], self.origin[1] + (j + 0.5) * self.cell[1]
+
     def nearest(self, x: float, y: float) -> int:
         """Index of the primitive nearest ``(x, y)`` (exact at cell centres).
 

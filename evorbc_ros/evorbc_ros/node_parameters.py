@@ -178,6 +178,13 @@ PARAMETERS: dict[str, tuple[ParamSpec, ...]] = {
         ),
         spec("sensor_layout", "", "the sensor nodes' layout (YAML); empty: the arbitrator's own"),
         spec("record_file", "", "append every choice here as JSON lines (m1, m2, x, y, primitive)"),
+        spec(
+            "adaptation",
+            False,
+            "correct the primitives' outcomes from odometry (odom) and choose by the "
+            "corrected ones (docs/design.md section 24); false: as evolved, and forgets",
+            live=True,
+        ),
         *MARKERS,
         *COMMON,
     ),

@@ -14,6 +14,14 @@ one line. Activate starts choosing, at once if a full set of readings came meanw
 deactivate publishes an empty primitive, which stops the robot. Health on
 ``/diagnostics``; with ``markers`` the mapping's target and the chosen primitive's
 expected displacement on ``~/markers`` (:mod:`evorbc_ros.nodes.managed`).
+
+With ``adaptation`` (off by default; applied live, and false forgets what was learned)
+the node also subscribes ``odom`` (nav_msgs/Odometry, sensor-data QoS: the radar node's
+odometry), chooses once a new pose has come with the readings, and runs the primitive
+whose outcome, corrected from what the primitives did, is nearest what the network's
+choice was recorded to do (docs/design.md section 24). ``~/reset_adaptation``
+(std_srvs/Empty) forgets the observations. Its state is in the health report, and the
+chosen primitive's corrected displacement in the markers.
 """
 
 from __future__ import annotations
@@ -24,6 +32,7 @@ import os
 import sys
 
 import numpy as np
+from nav_msgs.msg import Odometry
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Empty
 from visualization_msgs.msg import MarkerArray
@@ -31,11 +40,13 @@ from visualization_msgs.msg import MarkerArray
 from evorbc_ros.arbitration import DEACTIVATED, Controller, InputGroups
 from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, ships_controller
+from evorbc_ros.goal import yaw_from_quaternion
 from evorbc_ros.health import ERROR, WARN, Health, Meter, report_input, report_skipped
 from evorbc_ros.laser import InputError
 from evorbc_ros.marker_geometry import primitive_arrows
 from evorbc_ros.nodes.common import (
     DIAGNOSTICS,
+    SENSOR_DATA,
     StartupError,
     load_sensor_layout,
     now_seconds,
@@ -68,8 +79,14 @@ class ArbitratorNode(ManagedNode):
         self.meters = {t: Meter() for t in INPUTS}
         self.skipped, self.choices, self.halts, self.failures = Meter(), Meter(), Meter(), Meter()
         self.last_choice: list[float] = []
+        self.odom_sub = None  # made when adaptation starts
+        self.pose_fresh = False  # a pose came since the last choice (adaptation only)
+        self.poses = Meter()
         super().__init__(**kwargs)
         self.reset_service = self.create_service(Empty, "~/reset", self.on_reset)
+        self.reset_adaptation_service = self.create_service(
+            Empty, "~/reset_adaptation", self.on_reset_adaptation
+        )
 
     # -- lifecycle ----------------------------------------------------------------------
 
@@ -98,6 +115,8 @@ class ArbitratorNode(ManagedNode):
             self.markers = Markers(self, params["marker_frame"], pub)
         for t in self.groups.sizes:
             self.subscription(Float64MultiArray, t, lambda msg, t=t: self.on_input(t, msg))
+        if params["adaptation"]:
+            self.start_adaptation()
         self.get_logger().info(
             f"{spec.kind.name} controller for {spec.robot} from {self.controller.arbitrator_path}"
             + (
@@ -117,7 +136,7 @@ class ArbitratorNode(ManagedNode):
         self.controller.reset()
         if self.controller.recurrent:
             self.get_logger().info("recurrent network: its state starts at 0")
-        if all(self.groups.fresh.values()):
+        if self.ready():
             self.choose()
 
     def deactivate(self) -> None:
@@ -132,13 +151,72 @@ class ArbitratorNode(ManagedNode):
     def release(self) -> None:
         """Close the record file; drop the subscriptions, publishers and controller."""
         self.release_made()
-        self.pub = self.map_pub = self.markers = None
+        self.pub = self.map_pub = self.markers = self.odom_sub = None
         if self.record is not None:
             self.record.close()
             self.record = None
         self.controller = None
 
+    def start_adaptation(self) -> None:
+        """Adapt from the prior; subscribe odometry (once).
+
+        Raises:
+            StartupError: a standard-NEAT controller (no primitives to correct).
+        """
+        try:
+            self.controller.enable_adaptation()
+        except ValueError as e:
+            raise StartupError(f"parameter adaptation: {e}") from None
+        if self.odom_sub is None:
+            self.odom_sub = self.subscription(Odometry, "odom", self.on_odom, SENSOR_DATA)
+        self.pose_fresh = False
+        self.get_logger().info("adaptation on: correcting outcomes from odometry")
+
+    def apply_live(self, name: str, value) -> None:
+        """``adaptation``: true starts from the prior; false stops and forgets."""
+        if name != "adaptation" or self.controller is None:
+            return  # before configure: configure reads it
+        if value and self.controller.adaptation is None:
+            try:
+                self.start_adaptation()
+            except StartupError as e:
+                self.get_logger().error(str(e))
+        elif not value and self.controller.adaptation is not None:
+            self.controller.disable_adaptation()
+            self.get_logger().info("adaptation off: the recorded outcomes again")
+
+    def ready(self) -> bool:
+        """Every input group is new, and so is the pose when adapting."""
+        return all(self.groups.fresh.values()) and (
+            self.controller.adaptation is None or self.pose_fresh
+        )
+
     # -- callbacks ----------------------------------------------------------------------
+
+    def on_reset_adaptation(
+        self, request: Empty.Request, response: Empty.Response
+    ) -> Empty.Response:
+        """``~/reset_adaptation``: forget every observation (the recorded outcomes again)."""
+        if self.controller is None or self.controller.adaptation is None:
+            self.get_logger().info("reset_adaptation: adaptation is off, nothing to forget")
+            return response
+        self.controller.reset_adaptation()
+        self.get_logger().info("reset_adaptation: observations forgotten")
+        return response
+
+    def on_odom(self, msg: Odometry) -> None:
+        """Hand the pose to the controller; choose if the readings were waiting for it."""
+        if self.controller is None or self.controller.adaptation is None:
+            return
+        self.poses.tick(now_seconds(self))
+        pose = msg.pose.pose
+        q = pose.orientation
+        stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        yaw = yaw_from_quaternion(q.x, q.y, q.z, q.w)
+        self.controller.put_pose(stamp, pose.position.x, pose.position.y, yaw)
+        self.pose_fresh = True
+        if self.active and self.ready():
+            self.choose()
 
     def on_reset(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
         """``~/reset``: a recurrent network's state back to 0 (as at an episode's start).
@@ -165,7 +243,7 @@ class ArbitratorNode(ManagedNode):
             self.get_logger().warning(f"skipped a message: {e}", throttle_duration_sec=2.0)
             return
         self.meters[topic].tick(now)
-        if self.groups.put(topic, values) and self.active:
+        if self.groups.put(topic, values) and self.active and self.ready():
             self.choose()
 
     def choose(self) -> None:
@@ -177,6 +255,7 @@ class ArbitratorNode(ManagedNode):
         """
         now = now_seconds(self)
         inputs = self.groups.take()
+        self.pose_fresh = False
         try:
             genes, diagnostics = self.controller.step(inputs)
         except Exception as e:  # a controller bug must stop the robot, not the node
@@ -212,13 +291,17 @@ class ArbitratorNode(ManagedNode):
         rep = self.controller.repertoire
         k = int(index)
         move, turn = primitive_arrows(tuple(rep.behaviour[k]), float(rep.heading[k]), 0.1)
-        self.markers.publish(
-            [
-                sphere("mapping_target", (x, y), (1.0, 0.2, 0.8, 0.9), 0.05),
-                arrow("primitive", move, (0.2, 0.9, 0.2, 0.9), 0.02),
-                arrow("primitive", turn, (0.2, 0.9, 0.2, 0.9), 0.01, idx=1),
-            ]
-        )
+        out = [
+            sphere("mapping_target", (x, y), (1.0, 0.2, 0.8, 0.9), 0.05),
+            arrow("primitive", move, (0.2, 0.9, 0.2, 0.9), 0.02),
+            arrow("primitive", turn, (0.2, 0.9, 0.2, 0.9), 0.01, idx=1),
+        ]
+        if self.controller.adaptation is not None:  # what it is now expected to do
+            dx, dy, dh = self.controller.adaptation.model.corrected[k]
+            move, turn = primitive_arrows((float(dx), float(dy)), float(dh), 0.1)
+            out.append(arrow("corrected", move, (1.0, 0.6, 0.1, 0.9), 0.02))
+            out.append(arrow("corrected", turn, (1.0, 0.6, 0.1, 0.9), 0.01, idx=1))
+        self.markers.publish(out)
 
     def report(self, h: Health, now: float) -> None:
         """Inputs, choices per second, the chosen primitive, skipped and failed choices."""
@@ -232,6 +315,10 @@ class ArbitratorNode(ManagedNode):
         h.add("last choice", self.last_choice)
         h.add("no primitive", self.halts.count)
         h.add("failed choices", self.failures.count)
+        if self.controller is not None and self.controller.adaptation is not None:
+            report_input(h, "odometry", self.poses, now, STALE)
+            for key, value in self.controller.adaptation_state().items():
+                h.add(f"adaptation: {key}", value)
         if new_halts:
             h.worse(WARN, f"{new_halts} cycle(s) without a primitive (the robot stopped)")
         if new_failures:
