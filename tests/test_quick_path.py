@@ -56,6 +56,8 @@ def test_a_settings_file_robot_resumes_an_interrupted_step(tmp_path, capsys):
     code, out, err = run(capsys, str(HUSKY), "--out", str(tmp_path))
     assert code == 0, err
     assert "husky at the quick profile: 2 steps done" in out
+    # Its own maze is scaled to size the generated mazes it trains on: said once.
+    assert err.count("generated mazes: maze gaps scaled x5.342 to fit robot husky") == 1
     first = content_sha256(tmp_path / "husky.arbitrator.json")
     # Interrupted: the arbitrator's output gone, as before it was written; the rerun skips
     # the repertoire and runs the arbitrator again, to the same controller.
@@ -94,3 +96,38 @@ def test_bad_input_is_refused_in_one_line(tmp_path, capsys, source, words):
     code, _, err = run(capsys, source, "--out", str(tmp_path / "o"))
     assert code != 0
     assert words in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_a_urdfs_standing_options_reach_its_step(tmp_path):
+    standing = {"up": "y", "turn": (90.0, 0.0, 0.0), "stance": 0.55}
+    path = write_profile_recipe(
+        "pybullet_data:laikago/laikago_toes.urdf", "quick", tmp_path, 1, None, standing
+    )
+    step = load_recipe(path).step("urdf")
+    assert (step.up, step.turn, step.stance) == ("y", (90.0, 0.0, 0.0), 0.55)
+
+
+def test_a_y_up_urdf_stands_with_up_given(tmp_path, capsys):
+    """The A1 turned Y-up: refused without --up, naming it; its step stands it with it."""
+    import numpy as np
+    import pybullet_data
+
+    from offline_evolution.recipes.robot_steps import run_robot_from_urdf
+    from sim_bridge.legged.urdf_model import read_urdf, turned_urdf_text
+
+    yup = tmp_path / "a1_yup.urdf"
+    to_yup = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]).T
+    a1 = read_urdf(Path(pybullet_data.getDataPath()) / "a1" / "a1.urdf")
+    yup.write_text(turned_urdf_text(a1, to_yup, "A1, Y-up"))
+    code, _, err = run(capsys, str(yup), "--out", str(tmp_path / "a"))
+    assert code != 0 and "is Y-up" in err and "pass --up y" in err and "Traceback" not in err
+    path = write_profile_recipe(str(yup), "quick", tmp_path, 1, "dog", {"up": "y"})
+    lines: list[str] = []
+    run_robot_from_urdf(load_recipe(path).step("urdf"), tmp_path, lines.append)
+    assert "up y" in lines[0] and (tmp_path / "dog.urdf").is_file()
+    assert any("it stands" in line for line in lines)
+
+
+def test_standing_options_are_refused_for_a_settings_file(tmp_path, capsys):
+    code, _, err = run(capsys, str(HUSKY), "--out", str(tmp_path), "--up", "y")
+    assert code != 0 and "--up: only for a URDF" in err and "Traceback" not in err

@@ -83,6 +83,7 @@ def out_folder(path: str, option: str) -> Path:
 
 def cmd_mazes(args: argparse.Namespace) -> int:
     """Generate, save and draw the mazes; print one line per maze."""
+    from evorbc_ros.robots.adapters import report
     from offline_evolution.mazes.files import save_maze
     from offline_evolution.mazes.generator import generate_maze, spec_for_robot
     from offline_evolution.mazes.held_out import HELD_OUT_SEED
@@ -95,6 +96,8 @@ def cmd_mazes(args: argparse.Namespace) -> int:
     if picture is not None:
         check_output_file(picture, "--plot", picture=True)
     spec = spec_for_robot(args.robot)
+    if spec.warning:
+        report(spec.warning)
     prefix = "gen"
     if args.serpentine:  # a robot that cannot hold serpentines: generate_maze refuses it
         if args.seed == HELD_OUT_SEED:

@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from offline_evolution.commands.common import add_workers_option, count
+from offline_evolution.commands.robot_from_urdf import add_urdf_options
 from offline_evolution.runs.errors import UserError
 
 
@@ -60,6 +61,7 @@ def add_parsers(sub) -> None:
     )
     p.add_argument("--seed", type=count, default=1, help="seed of every step (default 1)")
     p.add_argument("--name", help="a URDF robot's name (default: the URDF's stem + '-urdf')")
+    add_urdf_options(p)
     p.add_argument(
         "--budget",
         choices=BUDGETS,
@@ -81,7 +83,9 @@ def cmd_from_robot(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {out} is not a folder")
     out.mkdir(parents=True, exist_ok=True)
-    path = write_profile_recipe(args.source, args.profile, out, args.seed, args.name)
+    standing = {"up": args.up, "turn": args.turn, "stance": args.stance}
+    standing = {k: v for k, v in standing.items() if v is not None}
+    path = write_profile_recipe(args.source, args.profile, out, args.seed, args.name, standing)
     recipe = load_recipe(path)
     outcomes = run_recipe(recipe, out, args.budget, args.workers, args.quiet)
     controller = outcomes[-1].out

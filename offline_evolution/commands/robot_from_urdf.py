@@ -29,6 +29,12 @@ def add_parsers(sub) -> None:
     p.add_argument("urdf", metavar="URDF", help="the URDF file, or pybullet_data:PATH")
     p.add_argument("--out", required=True, metavar="DIR", help="folder for the settings files")
     p.add_argument("--name", help="the robot's name (default: the URDF's robot name)")
+    add_urdf_options(p)
+    p.set_defaults(func=cmd_robot_from_urdf)
+
+
+def add_urdf_options(p: argparse.ArgumentParser) -> None:
+    """``--up``, ``--turn`` and ``--stance``: how to stand a URDF (robot-from-urdf, from-robot)."""
     p.add_argument(
         "--up",
         choices=("z", "y", "x", "-z", "-y", "-x"),
@@ -50,7 +56,6 @@ def add_parsers(sub) -> None:
         metavar="SHARE",
         help="standing height as a share of the straight leg (default 0.62, the A1's)",
     )
-    p.set_defaults(func=cmd_robot_from_urdf)
 
 
 def _urdf_path(text: str) -> Path:
@@ -67,10 +72,14 @@ def cmd_robot_from_urdf(args: argparse.Namespace) -> int:
     """Derive, write and check the settings; print what was derived."""
     from offline_evolution.commands.mazes import out_folder
 
-    turn = None if args.turn is None else tuple(math.radians(a) for a in args.turn)
     folder = out_folder(args.out, "--out")
-    write_robot_files(args.urdf, folder, args.name, args.up, turn, args.stance, print)
+    write_robot_files(args.urdf, folder, args.name, args.up, turn_rad(args.turn), args.stance)
     return 0
+
+
+def turn_rad(turn_deg) -> tuple[float, float, float] | None:
+    """``--turn``'s (roll, pitch, yaw) in deg as rad, or None when not given."""
+    return None if turn_deg is None else tuple(math.radians(a) for a in turn_deg)
 
 
 def write_robot_files(

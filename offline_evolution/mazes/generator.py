@@ -110,6 +110,8 @@ class MazeSpec:
     cell: float = 0.01  # grid of the path search
     wall_thickness: float = 0.01
     scale: float = 1.0  # the robot's maze was scaled up this much to fit it
+    #: Why the robot's maze was scaled (one line), for the run to report; "" when not.
+    warning: str = field(default="", compare=False)
 
     @property
     def snap(self) -> float:
@@ -126,17 +128,17 @@ def spec_for_robot(name: str) -> MazeSpec:
 
     Sizes come from the robot's default maze, scaled up uniformly when the robot does not
     fit it (:mod:`~sim_bridge.maze_fit`: its start, or a route keeping 1.2 times the
-    footprint radius; one warning line on stderr), so corridors, gaps, openings, wall
-    lengths, the start region and the target radius all grow with the footprint. A robot
-    that fits its maze (every shipped robot) gets exactly the sizes of that maze. The
-    longest path allowed is at most 2/3 of what the robot drives at its top speed in an
-    episode; a scaled maze too long for that is shortened to it (docs/design.md section 21).
+    footprint radius; the spec's ``warning`` says so, for the caller to report), so
+    corridors, gaps, openings, wall lengths, the start region and the target radius all
+    grow with the footprint. A robot that fits its maze (every shipped robot) gets exactly
+    the sizes of that maze. The longest path allowed is at most 2/3 of what the robot
+    drives at its top speed in an episode; a scaled maze too long for that is shortened
+    to it (docs/design.md section 21).
 
     Raises:
         ConfigError: the robot is unknown (naming the known ones), or its default maze
             is not solvable with its footprint at any scale (nothing to size mazes from).
     """
-    from evorbc_ros.robots.adapters import report
     from evorbc_ros.robots.registry import lookup
     from sim_bridge.maze_fit import fitted_maze
 
@@ -147,8 +149,6 @@ def spec_for_robot(name: str) -> MazeSpec:
         maze, scale, warning = fitted_maze(own, r, name)
     except ValueError as e:
         raise ConfigError(f"robot {name}: {e}; cannot size generated mazes from it") from None
-    if warning:
-        report(f"generated mazes: {warning}")
     margin = 1.2 * r
     # m; the hexapod's 2 m maze needs less. A scaled maze keeps its grid in cells.
     cell = (0.01 if own.size()[1] < 1.8 else 0.02) * scale
@@ -191,6 +191,7 @@ def spec_for_robot(name: str) -> MazeSpec:
         cell=cell,
         wall_thickness=t,
         scale=scale,
+        warning=f"generated mazes: {warning}" if warning else "",
     )
 
 

@@ -43,7 +43,12 @@ def is_urdf(source: str) -> bool:
 
 
 def write_profile_recipe(
-    source: str, profile: str, out: Path, seed: int, name: str | None = None
+    source: str,
+    profile: str,
+    out: Path,
+    seed: int,
+    name: str | None = None,
+    standing: dict | None = None,
 ) -> Path:
     """Write the profile's recipe for ``source`` into ``out``; return the recipe file.
 
@@ -54,9 +59,12 @@ def write_profile_recipe(
         seed: of every step.
         name: a URDF robot's name (default: the URDF file's stem, then ``-urdf``, so that
             it never takes a built-in robot's name).
+        standing: a URDF's ``up``, ``turn`` (deg, roll pitch yaw) and ``stance``, those
+            given, for its ``robot-from-urdf`` step.
 
     Raises:
-        ConfigError: one line: a source that is neither, a robot file that does not load.
+        ConfigError: one line: a source that is neither, a robot file that does not load,
+            standing options for a robot settings file.
     """
     spec = load_yaml_mapping(profile_path(profile))
     folder = out / "profile"
@@ -75,6 +83,7 @@ def write_profile_recipe(
                 "run": "robot-from-urdf",
                 "urdf": urdf,
                 "name": name,
+                **{k: list(v) if k == "turn" else v for k, v in (standing or {}).items()},
                 "out": f"{name}-model.yaml",
             },
             {
@@ -90,6 +99,9 @@ def write_profile_recipe(
     elif source.lower().endswith((".yaml", ".yml")) and Path(source).is_file():
         from evorbc_ros.robots.settings_robots import read_robot_file
 
+        if standing:
+            given = ", ".join(f"--{k}" for k in standing)
+            raise ConfigError(f"{given}: only for a URDF; {source} is a robot settings file")
         declared = read_robot_file(source)
         if declared is None:
             raise ConfigError(f"{source}: not a robot settings file (no kind key)")

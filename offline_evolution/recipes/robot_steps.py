@@ -87,9 +87,9 @@ def register_robots(recipe: Recipe, out: Path) -> None:
 
 def run_robot_from_urdf(step: RobotFromUrdfStep, out: Path, say: Callable[[str], None]) -> None:
     """``evorbc-evolve robot-from-urdf`` for ``step``, into the output folder."""
-    from offline_evolution.commands.robot_from_urdf import write_robot_files
+    from offline_evolution.commands.robot_from_urdf import turn_rad, write_robot_files
 
-    write_robot_files(step.urdf, out, step.name, step.up, say=say)
+    write_robot_files(step.urdf, out, step.name, step.up, turn_rad(step.turn), step.stance, say)
 
 
 def run_design_gait(

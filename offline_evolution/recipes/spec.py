@@ -112,6 +112,12 @@ class RobotFromUrdfStep(_Common):
     up: str | None = setting(
         None, doc="the URDF's up axis", choices=("z", "y", "x", "-z", "-y", "-x")
     )
+    turn: tuple[float, ...] | None = setting(
+        None, doc="deg: roll, pitch, yaw standing the URDF Z-up facing +x (overrides up)"
+    )
+    stance: float | None = setting(
+        None, doc="standing height as a share of the straight leg", minimum=0.2, maximum=0.99
+    )
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -217,6 +223,8 @@ def _resolved(step: Step, label: str, folder: Path, earlier: list[Step]) -> Step
             raise ConfigError(f"{label}: out must be {step.name}-model.yaml (NAME-model.yaml)")
         if not step.urdf.startswith("pybullet_data:"):
             files["urdf"] = str((folder / step.urdf).resolve())
+        if step.turn is not None and len(step.turn) != 3:
+            raise ConfigError(f"{label}: turn must be 3 angles in deg (roll, pitch, yaw)")
     for key in (
         "settings",
         "neat",

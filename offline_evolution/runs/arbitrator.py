@@ -248,7 +248,8 @@ def _plan(run: ArbitratorRun, report: Reporter) -> _Plan:
 def _check_mazes(task_settings, seed: int, robot: str, source: str, report: Reporter):
     """The task settings with its mazes fitted to the robot; refuse held-out mazes and seeds.
 
-    A maze the robot does not fit is scaled up to fit it (one ``report.warning`` line)
+    A maze the robot does not fit is scaled up to fit it (one ``report.warning`` line, and
+    one when its own maze is scaled to size the generated mazes it trains on)
     and the scale recorded with the task, so that the tasks built from the recorded
     settings later say nothing again (docs/design.md section 21); a maze no scale fits is
     refused before any work. Held out: docs/design.md section 22.
@@ -264,6 +265,15 @@ def _check_mazes(task_settings, seed: int, robot: str, source: str, report: Repo
     except ConfigError as e:
         raise UserError(f"{source}: {e}") from None
     check_training(task_mazes, task_settings.training, seed, source)
+    if task_settings.training is not None and task_settings.training.generated:
+        from offline_evolution.mazes.generator import spec_for_robot
+
+        try:
+            sizing = spec_for_robot(robot).warning  # its maze scaled to size the generated
+        except ConfigError as e:
+            raise UserError(f"{source}: training: {e}") from None
+        if sizing:
+            report.warning(sizing)
     return task_settings
 
 

@@ -159,13 +159,18 @@ def _suite_task(run: EvaluateRun, arb: ArbitratorFile, base):
             arb.robot,
             f"episode_time {base.episode_time} s; --starts {run.starts}",
         )
+        warning = ""
         if run.generated:
-            names += _generated_files(arb.robot, run.generated, run.generated_seed, Path(tmp))
+            files, warning = _generated_files(arb.robot, run.generated, run.generated_seed, tmp)
+            names += files
         settings = MazeTaskSettings(tuple(names), base.episode_time, 1, base.sensors)
         try:
-            return make_task(settings, arb.robot)
+            task = make_task(settings, arb.robot)
         except ConfigError as e:
             raise UserError(f"--mazes: {e}") from None
+        if warning:
+            task.warnings.append(warning)  # the robot's maze scaled to size the generated
+        return task
 
 
 def suite_mazes(given: list[str] | None, trained: tuple[str, ...], generated: bool) -> list[str]:
@@ -199,8 +204,12 @@ def load_arbitrator(run: EvaluateRun) -> tuple[ArbitratorFile, Path]:
     return ArbitratorFile.load(path), path
 
 
-def _generated_files(robot: str, n: int, seed: int, folder: Path) -> list[str]:
-    """Generate ``n`` mazes of ``seed`` for ``robot`` into ``folder``; their files."""
+def _generated_files(robot: str, n: int, seed: int, folder: str) -> tuple[list[str], str]:
+    """Generate ``n`` mazes of ``seed`` for ``robot`` into ``folder``.
+
+    Returns:
+        Their files, and the sizing's warning ("" unless the robot's maze was scaled).
+    """
     from offline_evolution.mazes.files import save_maze
     from offline_evolution.mazes.generator import generate_maze, spec_for_robot
 
@@ -208,10 +217,10 @@ def _generated_files(robot: str, n: int, seed: int, folder: Path) -> list[str]:
     files = []
     for k in range(n):
         maze = generate_maze(spec, seed, k).maze
-        path = folder / f"{maze.name}.yaml"
+        path = Path(folder) / f"{maze.name}.yaml"
         save_maze(maze, path)
         files.append(str(path))
-    return files
+    return files, spec.warning
 
 
 def _plot(task, suite, path: str, title: str) -> None:
