@@ -40,6 +40,7 @@ def test_the_a1_urdf_to_a_controller(tmp_path, capsys):
     code, out, err = run(capsys, "pybullet_data:a1/a1.urdf", "--out", str(tmp_path))
     assert code == 0, err
     assert "a1-urdf at the quick profile: 4 steps done" in out
+    assert "not beside this file" not in err  # its robot file names config:NAME
     for head in ("[1/4] urdf", "[2/4] design", "[3/4] repertoire", "[4/4] arbitrator"):
         assert f"{head} " in err and "running" in err
     controller = json.loads((tmp_path / "a1-urdf.arbitrator.json").read_text())

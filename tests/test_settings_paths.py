@@ -55,6 +55,23 @@ def test_a_robot_file_names_its_files_from_its_folder(tmp_path, capsys):
     assert deprecations(capsys.readouterr().err) == []
 
 
+def test_config_prefix_names_evorbc_s_own_files_from_anywhere(tmp_path, capsys):
+    """``config:NAME``: evorbc's config/ wherever it is installed, without a line."""
+    text = BURGER.read_text()
+    text = text.replace("neat: neat/4ws.ini", "neat: config:neat/4ws.ini")
+    text = text.replace("task: tasks/", "task: config:tasks/")
+    text = text.replace("sensors: sensors/", "sensors: config:sensors/")
+    (tmp_path / "mine.yaml").write_text(text)
+    robot = read_robot_file(tmp_path / "mine.yaml")
+    assert robot.settings.neat == "neat/4ws.ini" and robot.sensors.startswith("sensors/")
+    assert robot.settings.task == "tasks/maze-turtlebot3-burger.yaml"
+    # Only the two keys written without the prefix say they are not beside the file.
+    assert len(deprecations(capsys.readouterr().err)) == 2
+    (tmp_path / "bad.yaml").write_text(text.replace("config:neat/4ws.ini", "config:neat/no.ini"))
+    with pytest.raises(Exception, match=f"{config_dir() / 'neat' / 'no.ini'}"):
+        read_robot_file(tmp_path / "bad.yaml")
+
+
 def test_evorbc_s_own_robot_files_name_config_without_a_line(capsys):
     robot = read_robot_file(BURGER)
     assert robot.settings.neat == "neat/4ws.ini" and robot.sensors.startswith("sensors/")

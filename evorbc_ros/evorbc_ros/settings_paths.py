@@ -19,6 +19,9 @@ from pathlib import Path
 
 #: Deprecation lines already printed in this process (one per file and key).
 _SAID: set[str] = set()
+#: A path naming one of evorbc's own settings files wherever evorbc is installed
+#: (``config:tasks/maze-a1.yaml``), as ``pybullet_data:`` names a URDF of pybullet's.
+SHIPPED_PREFIX = "config:"
 
 
 def resolve_beside(
@@ -42,13 +45,23 @@ def resolve_beside(
             path found is written absolute.
 
     Returns:
-        The file beside ``source`` (or ``value`` if absolute): relative to ``shipped`` if
-        it lies within its parent folder, else absolute. Else, if only an old location has
-        it, ``value`` unchanged (so that whatever reads it from there still does), after
-        the deprecation line unless ``source`` is one of ``shipped``'s own files.
+        For ``config:NAME`` (:data:`SHIPPED_PREFIX`), ``NAME`` relative to ``shipped``
+        (absolute if it has no such file, so that "no such file" names where it was
+        looked for). Else the file beside ``source`` (or ``value`` if absolute): relative
+        to ``shipped`` if it lies within its parent folder, else absolute. Else, if only an
+        old location has it, ``value`` unchanged (so that whatever reads it from there
+        still does), after the deprecation line unless ``source`` is one of ``shipped``'s
+        own files.
         Else the absolute path beside ``source``, so that "no such file" names where it
         was looked for.
     """
+    if value.startswith(SHIPPED_PREFIX) and shipped is not None:
+        name = value[len(SHIPPED_PREFIX) :]
+        target = (shipped / name).resolve()
+        inside = target.is_relative_to(shipped.resolve()) and target.is_file()
+        return (
+            Path(os.path.relpath(target, shipped.resolve())).as_posix() if inside else str(target)
+        )
     path = Path(value).expanduser()
     beside = (Path(source).resolve().parent / path).resolve()  # an absolute path: itself
     if beside.exists():

@@ -276,22 +276,24 @@ def _drive(leg: Leg, role: str) -> str:
 def declaration_text(name: str, model_file: str, description: str) -> str:
     """The robot file registering the robot (docs/legged.md, "Registering it").
 
-    Its repertoire, arbitrator, NEAT, task, sensor and maze settings are the A1's, from
-    evorbc's ``config/``: copy them beside it to change them.
+    Its repertoire, arbitrator, NEAT, task, sensor and maze settings are the A1's, named
+    ``config:NAME`` (evorbc's ``config/`` wherever it is installed,
+    :data:`evorbc_ros.settings_paths.SHIPPED_PREFIX`): copy one beside it to change it.
     """
     return (
         f'# {name}: the robot file registering {model_file} (docs/legged.md, "Registering it").\n'
         "# Put this folder on $EVORBC_ROBOT_PATH. The search, sensor and maze settings are the\n"
-        "# A1's, from evorbc's config/: copy one beside this file to change it.\n"
+        "# A1's, from evorbc's config/ (config:NAME, wherever evorbc is installed): copy one\n"
+        "# beside this file and name it without config: to change it.\n"
         "kind: legged\n"
         f"model: {model_file}\n"
         f"description: {json.dumps(description)}\n"  # a YAML string
         "settings:\n"
-        "  repertoire: repertoire/a1.yaml\n"
-        "  arbitrator: arbitrator/a1.yaml\n"
-        "  neat: neat/a1.ini\n"
-        "  task: tasks/maze-a1.yaml\n"
-        "sensors: sensors/a1.yaml\n"
+        "  repertoire: config:repertoire/a1.yaml\n"
+        "  arbitrator: config:arbitrator/a1.yaml\n"
+        "  neat: config:neat/a1.ini\n"
+        "  task: config:tasks/maze-a1.yaml\n"
+        "sensors: config:sensors/a1.yaml\n"
         "maze: a1\n"
         "episode_time: 30.0\n"
         "equal_budget_generations: 455  # 1.025M x 2 s over 150 x 30 s, the A1's\n"
