@@ -58,9 +58,8 @@ def test_a_robot_file_names_its_files_from_its_folder(tmp_path, capsys):
 def test_config_prefix_names_evorbc_s_own_files_from_anywhere(tmp_path, capsys):
     """``config:NAME``: evorbc's config/ wherever it is installed, without a line."""
     text = BURGER.read_text()
-    text = text.replace("neat: neat/4ws.ini", "neat: config:neat/4ws.ini")
-    text = text.replace("task: tasks/", "task: config:tasks/")
-    text = text.replace("sensors: sensors/", "sensors: config:sensors/")
+    for key in ("neat: ", "task: ", "sensors: "):  # the other two stay config-relative
+        text = text.replace(key, f"{key}config:")
     (tmp_path / "mine.yaml").write_text(text)
     robot = read_robot_file(tmp_path / "mine.yaml")
     assert robot.settings.neat == "neat/4ws.ini" and robot.sensors.startswith("sensors/")
