@@ -48,9 +48,14 @@ def test_the_a1_urdf_to_a_controller(tmp_path, capsys):
     assert "design_search" in (tmp_path / "a1-urdf-designed.yaml").read_text()
     rep = json.loads((tmp_path / "a1-urdf.repertoire.json").read_text())
     assert rep["robot"] == "a1-urdf"
-    # A rerun finds every step done.
+    # Each stage's time is recorded (bench/bench_profiles.py reports it).
+    times = json.loads((tmp_path / "recipe-times.json").read_text())
+    assert list(times) == ["urdf", "design", "repertoire", "arbitrator"]
+    assert all(t["runs"] == 1 and t["wall_s"] > 0 and t["cpu_s"] > 0 for t in times.values())
+    # A rerun finds every step done, and times none.
     code, _, err = run(capsys, "pybullet_data:a1/a1.urdf", "--out", str(tmp_path))
     assert code == 0 and err.count("done before, skipped") == 4
+    assert json.loads((tmp_path / "recipe-times.json").read_text()) == times
 
 
 def test_a_settings_file_robot_resumes_an_interrupted_step(tmp_path, capsys):

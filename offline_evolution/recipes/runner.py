@@ -13,14 +13,19 @@ checkpoint are the command's defaults in the output folder (``OUT/<out>`` and
 
 The output folder records the recipe and budget it holds (``recipe-run.json``); a run of
 another recipe or budget is refused there, so a small run's files never pass for a full
-run's.
+run's. It also records each step's wall and CPU time, summed over the runs that resumed
+it (``recipe-times.json``): a profile's time per stage, as ``bench/bench_profiles.py``
+reports it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
+import resource
 import shutil
 import sys
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -43,6 +48,8 @@ from offline_evolution.runs import repertoire as repertoire_runs
 
 #: The file in an output folder that says which recipe and budget it holds.
 STATE_FILE = "recipe-run.json"
+#: Each step's time in an output folder: {step: {"wall_s", "cpu_s", "runs"}}.
+TIMES_FILE = "recipe-times.json"
 #: Checkpoint suffix of each kind of step (the runs' defaults).
 CHECKPOINT_SUFFIX = {
     "repertoire": repertoire_runs.CHECKPOINT_SUFFIX,
@@ -94,7 +101,9 @@ def run_recipe(
             ran = False
         else:
             say(f"{head}: running")
-            _run_step(recipe, step, out, budget, workers, quiet, say)
+            with _timed(out, step.step) as took:
+                _run_step(recipe, step, out, budget, workers, quiet, say)
+            say(f"{head}: done in {took[0] / 60:.1f} min (CPU {took[1] / 60:.1f} min)")
             ran = True
         verdict = None
         if budget == "full" and step.run in ("repertoire", "arbitrator", "copy"):
@@ -104,6 +113,43 @@ def run_recipe(
             say(f"[{i}/{len(recipe.steps)}] {step.step}: {verdict.text}")
         outcomes.append(StepOutcome(step.step, target, ran, verdict))
     return outcomes
+
+
+def _cpu_seconds() -> float:
+    """CPU time (s) of this process and of its worker processes that have ended."""
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + children.ru_utime + children.ru_stime
+
+
+@contextlib.contextmanager
+def _timed(out: Path, step: str):
+    """Add the block's wall and CPU time to ``step``'s in :data:`TIMES_FILE`.
+
+    Also when it is interrupted, so that a resumed step's time is the sum of its runs.
+    Yields a list that holds [wall s, CPU s] once the block ends.
+    """
+    took = [0.0, 0.0]
+    wall, cpu = time.perf_counter(), _cpu_seconds()
+    try:
+        yield took
+    finally:
+        took[:] = time.perf_counter() - wall, _cpu_seconds() - cpu
+        path = out / TIMES_FILE
+        try:
+            times = json.loads(path.read_text()) if path.is_file() else {}
+        except (OSError, ValueError):
+            times = {}  # a damaged record of times loses nothing a run needs
+        held = times.get(step) if isinstance(times.get(step), dict) else {}
+        try:
+            row = {
+                "wall_s": round(float(held.get("wall_s", 0)) + took[0], 1),
+                "cpu_s": round(float(held.get("cpu_s", 0)) + took[1], 1),
+                "runs": int(held.get("runs", 0)) + 1,
+            }
+        except (TypeError, ValueError):
+            row = {"wall_s": round(took[0], 1), "cpu_s": round(took[1], 1), "runs": 1}
+        times[step] = row
+        atomic_write_text(path, json.dumps(times, indent=1) + "\n")
 
 
 def _claim(out: Path, recipe: Recipe, budget: str) -> None:
