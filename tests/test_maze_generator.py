@@ -219,3 +219,37 @@ def test_serpentines_wind_through_narrow_shafts_and_stay_out_of_the_standard_mix
 
     assert all(0.32 <= closest_shaft(g) <= 0.51 for g in winding if "serpentine" in g.kinds)
     assert min(closest_shaft(g) for g in standard) > 0.51
+
+
+def test_a_robot_large_for_its_maze_gets_mazes():
+    """A footprint that leaves no room behind a baffle's face (the Laikago's from its URDF
+    in the A1's maze: 0.52 m) draws another target there, and mazes that need many draws
+    (the A1's mazes 17 of seed 1 and 11 of seed 2 needed more than 200) are found."""
+    import dataclasses
+
+    a1 = spec_for_robot("a1")
+    # The Laikago's spec: the A1's maze x1.05, a 0.52 m footprint (first obstacle and
+    # start inset from the margin, as spec_for_robot makes them).
+    f = 1.05
+    scaled = ("width", "height", "narrow_gap", "opening", "spacing", "start_offset")
+    scaled += ("start_length", "target_radius")
+    large = dataclasses.replace(
+        a1,
+        **{k: _times(getattr(a1, k), f) for k in scaled},
+        robot_radius=0.52,
+        margin=0.624,
+        start_inset=0.67725,
+        first_obstacle=1.24875,
+        path_limit=9.47,
+        cell=0.021,
+        wall_thickness=0.0105,
+        scale=f,
+    )
+    for k in range(3):
+        made = generate_maze(large, 1, k)
+        assert made.maze.start_misfit(0.52, "large") is None
+    assert generate_maze(a1, 1, 17).tries > 200 and generate_maze(a1, 2, 11).tries > 200
+
+
+def _times(value, factor: float):
+    return tuple(v * factor for v in value) if isinstance(value, tuple) else value * factor

@@ -128,6 +128,18 @@ def test_a_folder_holds_one_recipe_and_budget(tmp_path, capsys):
     )
 
 
+def test_a_folder_written_before_a_new_step_key_is_the_same_recipe():
+    """A key a later version added (None unless given) is not in an older folder's record."""
+    from offline_evolution.recipes.runner import _what_runs
+
+    step = {"step": "urdf", "run": "robot-from-urdf", "urdf": "a.urdf", "up": None}
+    old = {"recipe": {"recipe": "x", "steps": [step]}, "budget": "full"}
+    new = {"recipe": {"recipe": "x", "steps": [{**step, "turn": None, "stance": None}]}}
+    assert _what_runs(old) == _what_runs({**new, "budget": "full"})
+    given = {"recipe": {"recipe": "x", "steps": [{**step, "stance": 0.5}]}, "budget": "full"}
+    assert _what_runs(old) != _what_runs(given)
+
+
 GOOD_STEP = {"step": "rep", "run": "repertoire", "robot": "4ws-5", "settings": "rep.yaml",
              "seed": 1, "out": "rep.json"}  # fmt: skip
 

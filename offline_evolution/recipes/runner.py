@@ -176,10 +176,14 @@ VERDICT_KEYS = ("sha256", "content_sha256", "recipe_content_sha256", "note", "sh
 
 
 def _what_runs(state) -> object:
-    """A folder's recorded state without :data:`VERDICT_KEYS` (what decides its files)."""
+    """A folder's recorded state without :data:`VERDICT_KEYS` (what decides its files).
+
+    Keys left at None are dropped too: a step key added in a later version (None unless
+    given) does not make a folder written before it another recipe's.
+    """
     try:
         steps = [
-            {k: v for k, v in step.items() if k not in VERDICT_KEYS}
+            {k: v for k, v in step.items() if k not in VERDICT_KEYS and v is not None}
             for step in state["recipe"]["steps"]
         ]
         return {**state, "recipe": {**state["recipe"], "steps": steps}}
