@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from offline_evolution.commands.common import add_workers_option
+from offline_evolution.commands.common import add_workers_option, count
 from offline_evolution.runs.errors import UserError
 
 
@@ -37,6 +37,56 @@ def add_parsers(sub) -> None:
     p.add_argument("--quiet", action="store_true", help="no per-generation or per-batch lines")
     add_workers_option(p)
     p.set_defaults(func=cmd_recipe)
+
+    p = sub.add_parser(
+        "from-robot",
+        help="from a URDF or a robot settings file to a controller, at a profile's budgets",
+        description="Write the recipe of a profile (config/profiles/*.yaml) for a robot and "
+        "run it in one output folder: for a URDF, robot-from-urdf, design-gait, repertoire "
+        "and arbitrator; for a robot settings file, repertoire and arbitrator. Run it again "
+        "to resume (docs/your-robot.md, 'The quick path').",
+    )
+    p.add_argument(
+        "source",
+        metavar="URDF|ROBOT.yaml",
+        help="a URDF (or pybullet_data:PATH) or a robot settings file",
+    )
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.add_argument(
+        "--profile",
+        choices=("quick", "full"),
+        default="quick",
+        help="quick: about an hour on 2 cores; full: the paper's budgets (quick)",
+    )
+    p.add_argument("--seed", type=count, default=1, help="seed of every step (default 1)")
+    p.add_argument("--name", help="a URDF robot's name (default: the URDF's stem + '-urdf')")
+    p.add_argument(
+        "--budget",
+        choices=BUDGETS,
+        default="full",
+        help="small: every step on a tiny budget, to check the path (full)",
+    )
+    p.add_argument("--quiet", action="store_true", help="no per-generation or per-batch lines")
+    add_workers_option(p)
+    p.set_defaults(func=cmd_from_robot)
+
+
+def cmd_from_robot(args: argparse.Namespace) -> int:
+    """Write the profile's recipe for the robot and run it; 0 when every step is done."""
+    from offline_evolution.recipes.profiles import write_profile_recipe
+    from offline_evolution.recipes.runner import run_recipe
+    from offline_evolution.recipes.spec import load_recipe
+
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {out} is not a folder")
+    out.mkdir(parents=True, exist_ok=True)
+    path = write_profile_recipe(args.source, args.profile, out, args.seed, args.name)
+    recipe = load_recipe(path)
+    outcomes = run_recipe(recipe, out, args.budget, args.workers, args.quiet)
+    controller = outcomes[-1].out
+    print(f"{recipe.recipe}: {len(outcomes)} steps done -> {controller}")
+    return 0
 
 
 def cmd_recipe(args: argparse.Namespace) -> int:

@@ -65,23 +65,54 @@ def _urdf_path(text: str) -> Path:
 
 def cmd_robot_from_urdf(args: argparse.Namespace) -> int:
     """Derive, write and check the settings; print what was derived."""
-    from evorbc_ros.atomic_io import atomic_write_text
     from offline_evolution.commands.mazes import out_folder
+
+    turn = None if args.turn is None else tuple(math.radians(a) for a in args.turn)
+    folder = out_folder(args.out, "--out")
+    write_robot_files(args.urdf, folder, args.name, args.up, turn, args.stance, print)
+    return 0
+
+
+def write_robot_files(
+    urdf: str,
+    folder: Path,
+    name: str | None = None,
+    up: str | None = None,
+    turn: tuple[float, float, float] | None = None,
+    stance: float | None = None,
+    say=print,
+) -> Path:
+    """Derive a legged robot's settings from ``urdf`` and write them into ``folder``.
+
+    Args:
+        urdf: the URDF file, or ``pybullet_data:PATH``.
+        folder: an existing folder; NAME-model.yaml, NAME.yaml (and NAME.urdf for a URDF
+            that is not Z-up) are written there atomically, the model file last but one.
+        name: the robot's name (default: the URDF's).
+        up, turn: the URDF's up axis, or the turn (rad, roll pitch yaw) standing it Z-up.
+        stance: standing height as a share of the straight leg (default 0.62).
+        say: called with each report line.
+
+    Returns:
+        The settings file written (``folder / NAME-model.yaml``).
+
+    Raises:
+        UserError, ConfigError: one line saying what to set.
+    """
+    from evorbc_ros.atomic_io import atomic_write_text
     from sim_bridge.legged.urdf_check import stand_check
     from sim_bridge.legged.urdf_model import turned_urdf_text
     from sim_bridge.legged.urdf_reader import STANCE, read_legged_urdf
     from sim_bridge.legged.urdf_settings import declaration_text, settings_text
 
-    stance = STANCE if args.stance is None else args.stance
+    stance = STANCE if stance is None else stance
     if not 0.2 <= stance < 1.0:
         raise UserError(f"--stance {stance:g}: expected a share in [0.2, 1)")
-    path = _urdf_path(args.urdf)
-    turn = None if args.turn is None else tuple(math.radians(a) for a in args.turn)
-    derived = read_legged_urdf(path, up=args.up, turn_rpy=turn, stance=stance)
-    name = args.name or re.sub(r"[^A-Za-z0-9._+-]", "-", derived.model.name)
+    path = _urdf_path(urdf)
+    derived = read_legged_urdf(path, up=up, turn_rpy=turn, stance=stance)
+    name = name or re.sub(r"[^A-Za-z0-9._+-]", "-", derived.model.name)
     if not _NAME.fullmatch(name):
         raise UserError(f"--name {name!r}: expected letters, digits and . _ + - (a letter first)")
-    folder = out_folder(args.out, "--out")
     model_file = folder / f"{name}-model.yaml"
     turned = None
     if derived.turned:
@@ -96,21 +127,21 @@ def cmd_robot_from_urdf(args: argparse.Namespace) -> int:
     legs = len(derived.legs)
     description = f"{name} from {path.name}: {legs} legs, {1 + 6 * legs}-parameter periodic gait"
     atomic_write_text(folder / f"{name}.yaml", declaration_text(name, model_file.name, description))
-    print(
+    say(
         f"{name}: {legs} legs ({', '.join(leg.name for leg in derived.legs)}), base "
         f"{derived.base}, up {derived.up} ({derived.turn_given})"
     )
     for leg in derived.legs:
         c0, c1 = leg.coupling
-        print(
+        say(
             f"  {leg.name}: {leg.side}, mirror {leg.mirror}, foot {leg.foot}; standing knee "
             f"{math.degrees(leg.knee_stand):.1f} deg, thigh = {math.degrees(c0):.2f} deg "
             f"{c1:+.4f} x knee (+ swing)"
         )
     standing = "stands" if measured.tilt < 10.0 else "does NOT stand"
-    print(
+    say(
         f"standing check: it {standing} ({measured.seconds:g} s: height {measured.height:.3f} m, "
         f"tilt at most {measured.tilt:.1f} deg, footprint {measured.reach_radius:.3f} m)"
     )
-    print(f"wrote {model_file} and {folder / (name + '.yaml')}; export EVORBC_ROBOT_PATH={folder}")
-    return 0
+    say(f"wrote {model_file} and {folder / (name + '.yaml')}; export EVORBC_ROBOT_PATH={folder}")
+    return model_file

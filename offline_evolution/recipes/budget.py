@@ -20,12 +20,18 @@ import yaml
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.config import config_dir, load_yaml_mapping
 from offline_evolution.arbitrator.settings import load_run_settings
+from offline_evolution.gait_design.objective import Budget
 from sim_bridge.maze import is_maze_file
 
 BUDGETS = ("full", "small")
 #: MAP-Elites: initial batch, batch size and iterations of the small budget.
 SMALL_REPERTOIRE = {"initial_batch": 40, "batch_size": 20, "iterations": 1}
 SMALL_GENERATIONS = 2
+#: The gait design search of the small budget: two Sobol designs and one refinement, each
+#: on 3 primitives and one 0.5 s switching episode.
+SMALL_DESIGN = Budget(
+    gaits=3, accuracy=1, episodes=1, episode_time=0.5, sobol=2, refine=1, validate=1
+)
 #: Genomes a generation, and the species NEAT aims for: the population must hold
 #: target_species_count x min_species_size genomes (2 a species in the shipped files).
 SMALL_POPULATION = 6
@@ -93,11 +99,8 @@ def _small_neat(path: Path) -> str:
     return buf.getvalue()
 
 
-def _small_task(path: Path) -> str:
-    """The task settings of ``path`` with short episodes and few generated mazes.
-
-    Its paths, resolved beside ``path``, are written absolute: the copy lies elsewhere.
-    """
+def portable_task(path: Path) -> dict:
+    """The task settings of ``path`` with its paths absolute, for a copy that lies elsewhere."""
     from offline_evolution.maze_task.base import task_file_values
 
     data = task_file_values(path)
@@ -108,6 +111,12 @@ def _small_task(path: Path) -> str:
             str(Path(m).resolve()) if isinstance(m, str) and is_maze_file(m) else m
             for m in data["mazes"]
         ]
+    return data
+
+
+def _small_task(path: Path) -> str:
+    """The task settings of ``path`` with short episodes and few generated mazes."""
+    data = portable_task(path)
     data["episode_time"] = min(float(data.get("episode_time", 120.0)), SMALL_EPISODE_TIME)
     training = data.get("training")
     if isinstance(training, dict):

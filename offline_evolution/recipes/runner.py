@@ -28,8 +28,16 @@ from pathlib import Path
 from evorbc_ros.atomic_io import atomic_path, atomic_write_text
 from evorbc_ros.config import ConfigError
 from offline_evolution.recipes import budget as budgets
+from offline_evolution.recipes import robot_steps
 from offline_evolution.recipes.digest import Verdict
-from offline_evolution.recipes.spec import ArbitratorStep, CopyStep, Recipe, RepertoireStep
+from offline_evolution.recipes.spec import (
+    ArbitratorStep,
+    CopyStep,
+    DesignGaitStep,
+    Recipe,
+    RepertoireStep,
+    RobotFromUrdfStep,
+)
 from offline_evolution.runs import arbitrator as arbitrator_runs
 from offline_evolution.runs import repertoire as repertoire_runs
 
@@ -39,6 +47,7 @@ STATE_FILE = "recipe-run.json"
 CHECKPOINT_SUFFIX = {
     "repertoire": repertoire_runs.CHECKPOINT_SUFFIX,
     "arbitrator": arbitrator_runs.CHECKPOINT_SUFFIX,
+    "design-gait": robot_steps.DESIGN_CHECKPOINT_SUFFIX,
 }
 
 
@@ -85,10 +94,10 @@ def run_recipe(
             ran = False
         else:
             say(f"{head}: running")
-            _run_step(recipe, step, out, budget, workers, quiet)
+            _run_step(recipe, step, out, budget, workers, quiet, say)
             ran = True
         verdict = None
-        if budget == "full":
+        if budget == "full" and step.run in ("repertoire", "arbitrator", "copy"):
             verdict = Verdict.of(
                 target, step.sha256, step.content_sha256, step.recipe_content_sha256, step.shipped
             )
@@ -139,31 +148,42 @@ def _finished(step, target: Path) -> bool:
     return target.is_file() and not (checkpoint and checkpoint.exists())
 
 
-def _run_step(recipe: Recipe, step, out: Path, budget: str, workers, quiet: bool) -> None:
+def _run_step(recipe: Recipe, step, out: Path, budget: str, workers, quiet: bool, say) -> None:
     from offline_evolution.runs import terminal
 
     target = out / step.out
-    if isinstance(step, CopyStep):
+    if isinstance(step, RepertoireStep | ArbitratorStep):
+        robot_steps.register_robots(recipe, out)
+    if isinstance(step, RobotFromUrdfStep):
+        robot_steps.run_robot_from_urdf(step, out, say)
+    elif isinstance(step, DesignGaitStep):
+        robot_steps.run_design_gait(recipe, step, out, budget, say)
+    elif isinstance(step, CopyStep):
         source = out / recipe.step(step.source).out
         with atomic_path(target) as tmp:
             shutil.copyfile(source, tmp)
     elif isinstance(step, RepertoireStep):
-        terminal.repertoire(_repertoire_run(step, budget, target), workers, quiet)
+        run = _repertoire_run(step, robot_steps.robot_name(recipe, step), budget, target)
+        terminal.repertoire(run, workers, quiet)
     elif isinstance(step, ArbitratorStep):
         terminal.arbitrator(_arbitrator_run(recipe, step, out, budget, target), workers, quiet)
     else:  # pragma: no cover - the loader knows no other kind
         raise ConfigError(f"{recipe.path}: step {step.step}: unknown kind {step.run!r}")
 
 
-def _repertoire_run(step: RepertoireStep, budget: str, target: Path):
-    """The ``RepertoireRun`` of ``step`` at ``budget``, written to ``target``."""
+def _repertoire_run(step: RepertoireStep, robot: str, budget: str, target: Path):
+    """The ``RepertoireRun`` of ``step`` for ``robot`` at ``budget``, written to ``target``."""
     from offline_evolution.runs.repertoire import RepertoireRun
 
     run = RepertoireRun(
-        robot=step.robot,
+        robot=robot,
         config=step.settings,
         seed=step.seed,
         iterations=step.iterations,
+        initial_batch=step.initial_batch,
+        batch_size=step.batch_size,
+        archive=step.archive,
+        variation=step.variation,
         out=str(target),
     )
     return replace(run, **budgets.SMALL_REPERTOIRE) if budget == "small" else run

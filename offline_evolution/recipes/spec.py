@@ -9,7 +9,16 @@ A recipe names its steps in order. Each step runs one kind of job and writes one
   ``repertoire`` an earlier step wrote (or ``repertoire_file``), and optionally warm
   started from the arbitrator an earlier step wrote (``init_from``, or ``init_from_file``);
 * ``copy``: the output of an earlier step under another name (a shipped file that was
-  renamed: the name is recorded in the files that read it).
+  renamed: the name is recorded in the files that read it);
+* ``robot-from-urdf``: a legged robot's settings derived from a ``urdf``
+  (``evorbc-evolve robot-from-urdf``); its ``out`` is ``NAME-model.yaml``;
+* ``design-gait``: the gait design search (``evorbc-evolve design-gait``) over the
+  settings an earlier step wrote (``settings_step``), at a ``budget`` with a ``seed``.
+
+A repertoire step's robot is a registered ``robot``, a robot settings file
+(``robot_file``, its folder put on ``$EVORBC_ROBOT_PATH`` for the run) or the legged
+robot of an earlier ``robot-from-urdf`` or ``design-gait`` step (``robot_step``): the
+quick path (docs/your-robot.md, "The quick path").
 
 Relative paths in a recipe are from the recipe file's folder. A step may state what the
 shipped file is: its ``sha256`` and ``content_sha256`` (:mod:`.digest`), and, where the
@@ -29,7 +38,7 @@ from evorbc_ros.config import ConfigError, build_settings, load_yaml_mapping, se
 from evorbc_ros.robots.registry import ROBOT_NAMES
 
 #: Step kinds, by the value of a step's ``run`` key.
-KINDS = ("repertoire", "arbitrator", "copy")
+KINDS = ("repertoire", "arbitrator", "copy", "robot-from-urdf", "design-gait")
 #: What a step name and an output name may be: a plain file name, no folders.
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
 _SHA256 = re.compile(r"[0-9a-f]{64}")
@@ -60,10 +69,16 @@ class _Common:
 class RepertoireStep(_Common):
     """``evorbc-evolve repertoire --robot ROBOT --config SETTINGS --seed SEED``."""
 
-    robot: str = setting(doc="robot type", choices=ROBOT_NAMES)
-    settings: str = setting(doc="MAP-Elites settings file")
+    robot: str | None = setting(None, doc="robot type", choices=ROBOT_NAMES)
+    robot_file: str | None = setting(None, doc="a robot settings file, if not registered")
+    robot_step: str | None = setting(None, doc="the earlier step whose legged robot it is")
+    settings: str | None = setting(None, doc="MAP-Elites settings file (default: the robot's)")
     seed: int = setting(doc="random seed", minimum=0)
     iterations: int | None = setting(None, doc="iterations (default: the settings')", minimum=0)
+    initial_batch: int | None = setting(None, doc="S_G (default: the settings')", minimum=1)
+    batch_size: int | None = setting(None, doc="S_B (default: the settings')", minimum=1)
+    archive: str | None = setting(None, doc="grid or cvt (default: the settings')")
+    variation: str | None = setting(None, doc="paper or iso_line_dd (default: the settings')")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -88,8 +103,34 @@ class CopyStep(_Common):
     source: str = setting(doc="the earlier step whose output is copied")
 
 
-_CLASSES = {"repertoire": RepertoireStep, "arbitrator": ArbitratorStep, "copy": CopyStep}
-Step = RepertoireStep | ArbitratorStep | CopyStep
+@dataclass(frozen=True, kw_only=True)
+class RobotFromUrdfStep(_Common):
+    """``evorbc-evolve robot-from-urdf URDF --out OUT --name NAME``."""
+
+    urdf: str = setting(doc="the URDF (relative to the recipe, absolute, or pybullet_data:PATH)")
+    name: str = setting(doc="the robot's name; out must be NAME-model.yaml")
+    up: str | None = setting(
+        None, doc="the URDF's up axis", choices=("z", "y", "x", "-z", "-y", "-x")
+    )
+
+
+@dataclass(frozen=True, kw_only=True)
+class DesignGaitStep(_Common):
+    """``evorbc-evolve design-gait SETTINGS --out OUT --seed SEED --budget BUDGET``."""
+
+    settings_step: str = setting(doc="the earlier step whose legged settings it designs")
+    seed: int = setting(doc="random seed", minimum=0)
+    budget: str = setting("quick", doc="the search's budget", choices=("quick", "full"))
+
+
+_CLASSES = {
+    "repertoire": RepertoireStep,
+    "arbitrator": ArbitratorStep,
+    "copy": CopyStep,
+    "robot-from-urdf": RobotFromUrdfStep,
+    "design-gait": DesignGaitStep,
+}
+Step = RepertoireStep | ArbitratorStep | CopyStep | RobotFromUrdfStep | DesignGaitStep
 
 
 @dataclass(frozen=True)
@@ -171,7 +212,20 @@ def _resolved(step: Step, label: str, folder: Path, earlier: list[Step]) -> Step
     """``step`` with its file keys made absolute and its step references checked."""
     names = [s.step for s in earlier]
     files = {}
-    for key in ("settings", "neat", "task", "repertoire_file", "init_from_file", "shipped"):
+    if isinstance(step, RobotFromUrdfStep):
+        if step.out != f"{step.name}-model.yaml":
+            raise ConfigError(f"{label}: out must be {step.name}-model.yaml (NAME-model.yaml)")
+        if not step.urdf.startswith("pybullet_data:"):
+            files["urdf"] = str((folder / step.urdf).resolve())
+    for key in (
+        "settings",
+        "neat",
+        "task",
+        "repertoire_file",
+        "init_from_file",
+        "shipped",
+        "robot_file",
+    ):
         value = getattr(step, key, None)
         if value is None:
             continue
@@ -182,14 +236,18 @@ def _resolved(step: Step, label: str, folder: Path, earlier: list[Step]) -> Step
                 "recipe's folder)"
             )
         files[key] = str(target.resolve())
-    pairs = (("repertoire", "repertoire_file", True), ("init_from", "init_from_file", False))
-    for key, file_key, needed in pairs:
-        if not hasattr(step, key):
+    pairs = (
+        (("repertoire", "repertoire_file"), True),
+        (("init_from", "init_from_file"), False),
+        (("robot", "robot_file", "robot_step"), True),
+    )
+    for keys, needed in pairs:
+        if not hasattr(step, keys[0]):
             continue
-        given = [k for k in (key, file_key) if getattr(step, k) is not None]
+        given = [k for k in keys if getattr(step, k) is not None]
         if len(given) > 1 or (needed and not given):
-            raise ConfigError(f"{label}: give one of {key} (an earlier step) or {file_key}")
-    for key in ("repertoire", "init_from", "source"):
+            raise ConfigError(f"{label}: give one of {', '.join(keys)}")
+    for key in ("repertoire", "init_from", "source", "robot_step", "settings_step"):
         value = getattr(step, key, None)
         if value is not None and value not in names:
             known = ", ".join(names) or "none"
