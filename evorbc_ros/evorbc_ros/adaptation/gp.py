@@ -196,9 +196,10 @@ def observe(
     residual[s, 2] = o2 - expected[index, 2]
     counts[OBSERVATIONS] += 1
     refit(kzx, slots, residual, used, noise, inverse, alpha, correction)
-    for i in range(recorded.shape[0]):
-        for c in range(3):
-            corrected[i, c] = recorded[i, c] + correction[c, i]
+    # Whole columns: one IEEE addition per element either way, and plain numpy pays per
+    # call, not per element (as a loop over elements it cost 9 ms a refit at 10,000).
+    for c in range(3):
+        corrected[:, c] = recorded[:, c] + correction[c]
 
 
 #: The functions above, callees first (each may call only those before it).
