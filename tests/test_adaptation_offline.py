@@ -65,8 +65,11 @@ def test_the_lockstep_graph_adapting_drives_a_damaged_robot_as_the_offline_episo
     plain = task.evaluate([arb.network], controller, starts, record=True, world=world)
     task.adapt(adapting(rep, AdaptationSettings(), task.dt))
     result = task.evaluate([arb.network], controller, starts, record=True, world=world)
-    run = GraphRun(tmp_path, 187, "gaps", episode_time=25.0, arbitrator=path,
-                   bridge={"perturb": "4ws-stuck-steering", "seed": 4},
+    # odom twice: the bridge starts once the adapting arbitrator has subscribed it too
+    # (a first pose it missed would be sent again, and the other nodes answer twice).
+    bridge = {"perturb": "4ws-stuck-steering", "seed": 4,
+              "wait_for_subscribers": ["scan", "odom", "odom"]}  # fmt: skip
+    run = GraphRun(tmp_path, 187, "gaps", episode_time=25.0, arbitrator=path, bridge=bridge,
                    arbitrator_params={"adaptation": True})  # fmt: skip
     got = run.finish(timeout=120)
     choices = run.recorded_choices()
