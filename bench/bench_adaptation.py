@@ -36,7 +36,7 @@ import time
 import numpy as np
 from bench_repertoire import machine
 
-from evorbc_ros.adaptation import AdaptationSettings, OnlineAdaptation, gp
+from evorbc_ros.adaptation import AdaptationSettings, OnlineAdaptation, cycles
 from evorbc_ros.adaptation.model import OutcomeModel, outcome_table
 from evorbc_ros.adaptation.motion import extend_arc
 from evorbc_ros.defaults import default_repertoire
@@ -75,9 +75,7 @@ def worst(outcomes, settings, functions, cycles, rng, hold_max) -> np.ndarray:
 
 def run(outcomes, settings, functions, cycles, rng, hold_max) -> np.ndarray:
     """Seconds per cycle of the adaptation work over ``cycles`` cycles."""
-    adapt = OnlineAdaptation(outcomes, T, settings)
-    if functions is not None:
-        adapt.model = OutcomeModel(outcomes, settings, functions=functions)
+    adapt = OnlineAdaptation(outcomes, T, settings, functions=functions)
     n = len(outcomes)
     x = y = h = 0.0
     index, left = 0, 0
@@ -111,7 +109,7 @@ def main() -> None:
         os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
     import numba as nb
 
-    compiled = gp.compiled(nb.njit)
+    compiled = cycles.compiled(nb.njit)
     sizes = {name: len(Repertoire.load(default_repertoire(name))) for name in SHIPPED}
     largest = max(sizes, key=sizes.get)
     rep = Repertoire.load(default_repertoire(largest))

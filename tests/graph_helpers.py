@@ -39,9 +39,11 @@ class GraphRun:
         repertoire="",
         robot="4ws-5",
         bridge=None,
+        arbitrator_params=None,
     ):
         """``bridge``: more parameters of the bridge (e.g. the ``laser_range`` that
-        :func:`sim_bridge.graph.sim_graph` gives a large robot's controller)."""
+        :func:`sim_bridge.graph.sim_graph` gives a large robot's controller);
+        ``arbitrator_params``: more of the arbitrator node (e.g. ``adaptation``)."""
         self.env = graph_env(domain)
         self.result = tmp_path / f"{maze}-{mode}.json"
         self.log = open(tmp_path / f"{maze}-{mode}.log", "w")  # noqa: SIM115
@@ -56,6 +58,7 @@ class GraphRun:
                 params.update(
                     record_file=str(self.choices), arbitrator=self.arb, repertoire=str(repertoire)
                 )
+                params.update(arbitrator_params or {})
             if name == "primitive_executor":
                 # As sim_bridge.graph sets it: every command answers a primitive.
                 params.update(robot=robot, lockstep=mode == "lockstep")

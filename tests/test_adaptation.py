@@ -186,3 +186,49 @@ def test_settings_are_checked():
         AdaptationSettings(noise=0.0)
     with pytest.raises(ValueError, match="adaptation match must be one of outcome, point"):
         AdaptationSettings(match="nearest")
+
+
+def test_remainder_is_math_remainder_plain_and_compiled():
+    from evorbc_ros.adaptation.motion import remainder
+
+    jitted = nb.njit(remainder)
+    y = 2.0 * math.pi
+    xs = np.random.default_rng(0).uniform(-40.0, 40.0, 20_000).tolist()
+    xs += [0.0, -0.0, math.pi, -math.pi, 3 * math.pi, 0.5 * y, 1.5 * y, -1.5 * y, 2.5 * y, y]
+    for x in xs:
+        want = np.float64(math.remainder(x, y)).tobytes()
+        assert np.float64(remainder(x, y)).tobytes() == want
+        assert np.float64(jitted(x, y)).tobytes() == want
+
+
+def test_compiled_settled_cycle_rule_gives_the_same_bits(recorded):
+    from evorbc_ros.adaptation import cycles
+
+    rng = np.random.default_rng(3)
+    n = len(recorded)
+    runs = [
+        OnlineAdaptation(recorded, T, AdaptationSettings(window=3)),
+        OnlineAdaptation(
+            recorded, T, AdaptationSettings(window=3), functions=cycles.compiled(nb.njit)
+        ),
+    ]
+    x = y = h = 0.0
+    index = left = 0
+    for t in range(1500):
+        if left == 0:
+            index, left = int(rng.integers(n)), int(rng.integers(1, 12))
+        left -= 1
+        chosen = []
+        for a in runs:
+            a.put_pose(t * 100_000_000, x, y, h)
+            a.before_choice()
+            chosen.append(a.choose(0.0, 0.0, index))
+            a.after_choice(chosen[-1])
+        assert chosen[0] == chosen[1]
+        dx, dy, dh = recorded[chosen[0]] * (0.04 if chosen[0] % 2 else 0.06)
+        x, y = x + math.cos(h) * dx - math.sin(h) * dy, y + math.sin(h) * dx + math.cos(h) * dy
+        h += dh
+    assert runs[0].model.observations > 10
+    assert runs[0].model.corrected.tobytes() == runs[1].model.corrected.tobytes()
+    assert runs[0].ints.tolist() == runs[1].ints.tolist()
+    assert runs[0].floats.tobytes() == runs[1].floats.tobytes()

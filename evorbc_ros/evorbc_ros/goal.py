@@ -30,6 +30,15 @@ def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
     norm = math.sqrt(sum(v * v for v in q))
     if not 0.9 < norm < 1.1:
         raise InputError(f"orientation quaternion has length {norm:.3g}, expected 1")
+    return quaternion_yaw(x, y, z, w)
+
+
+def quaternion_yaw(x: float, y: float, z: float, w: float) -> float:
+    """Yaw (rad, about z) of a unit quaternion, unchecked; numba compiles it to the same bits.
+
+    The offline episode kernel computes an adapting controller's odometry yaw with it, as
+    the arbitrator node does from the odometry message (docs/design/adaptation.md).
+    """
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 

@@ -9,6 +9,7 @@ from evorbc_ros.robots.registry import DEFAULT_ROBOT
 from offline_evolution import bounds
 from offline_evolution.commands.common import at_least, count
 from offline_evolution.commands.replay import REPERTOIRE_DEFAULT
+from offline_evolution.maze_task.adapting import EXPECTED
 from offline_evolution.runs.command_line import from_arguments
 from offline_evolution.runs.console import EpisodePrinter, WarningPrinter
 from offline_evolution.runs.evaluate import PAPER, EvaluateRun, evaluate_run
@@ -80,6 +81,19 @@ def add_parsers(sub) -> None:
     p.add_argument("--plot", metavar="FILE.png", help="picture of the suite with every path")
     p.add_argument("--out", metavar="FILE.json", help="write the report as JSON")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.add_argument(
+        "--adapt",
+        action="store_true",
+        help="run the suite a second time, the same starts and worlds, with the controller "
+        "adapting onboard (docs/design/adaptation.md), and report both",
+    )
+    p.add_argument(
+        "--adapt-expected",
+        choices=EXPECTED,
+        default=EvaluateRun.adapt_expected,
+        help="what an observation is compared with: the recorded outcomes, as the "
+        "arbitrator node does (default), or the 4WS model's settled ones",
+    )
     add_flag(p, WAIVER)
     p.set_defaults(func=cmd_evaluate)
 
@@ -101,6 +115,19 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     if report.get("per_damage"):
         print(f"by damaged part ({report['perturbation']['damage']['kind']}):")
         _print_table(report["per_damage"], None)
+    adapted = report.get("adaptation")
+    if adapted:
+        print(f"with adaptation (expected: {adapted['expected']}):")
+        _print_table(adapted["per_maze"], adapted["overall"])
+        if adapted.get("per_damage"):
+            print(f"with adaptation, by damaged part ({report['perturbation']['damage']['kind']}):")
+            _print_table(adapted["per_damage"], None)
+        pairs = zip(report["episodes"], adapted["episodes"], strict=True)
+        won = lost = 0
+        for off, on in pairs:
+            won += on["reached"] and not off["reached"]
+            lost += off["reached"] and not on["reached"]
+        print(f"adaptation: {won} episodes reached only with it, {lost} only without")
     return 0
 
 

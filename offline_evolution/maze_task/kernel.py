@@ -36,9 +36,11 @@ import numba as nb
 import numpy as np
 
 from evorbc_ros import mapping as onboard_mapping
+from evorbc_ros.adaptation import cycles as adaptation_cycles
+from evorbc_ros.goal import quaternion_yaw
 from offline_evolution.arbitrator.compiled import activate, activate_recurrent
 from sim_bridge.four_ws.motion import HEADING, STATE_SIZE, X, Y, speed_through_wheels
-from sim_bridge.geometry import grid_candidates
+from sim_bridge.geometry import grid_candidates, planar_quaternion
 from sim_bridge.hashing import hash_uniform as _hash_uniform
 from sim_bridge.kinematics import halt, step_model, step_model_damaged
 from sim_bridge.sensors import read_sensors
@@ -46,6 +48,14 @@ from sim_bridge.sensors import read_sensors
 map_point = nb.njit(cache=True)(onboard_mapping.map_point)
 clamped_cell = nb.njit(cache=True)(onboard_mapping.clamped_cell)
 NO_PRIMITIVE = onboard_mapping.NO_PRIMITIVE
+# The onboard controller's adaptation (docs/design/adaptation.md), compiled: the same bits.
+_ADAPT = adaptation_cycles.compiled(nb.njit)
+_put_pose = _ADAPT["put_pose"]
+_before_choice = _ADAPT["before_choice"]
+_after_choice = _ADAPT["after_choice"]
+_adapted_choice = _ADAPT["choose"]
+_quaternion_yaw = nb.njit(cache=True)(quaternion_yaw)
+_planar_quaternion = nb.njit(cache=True)(planar_quaternion)
 
 #: Controller modes.
 EVORBC, STANDARD = 0, 1
@@ -83,6 +93,33 @@ class WorldDraws(NamedTuple):
     on: bool
     params: np.ndarray
     keys: np.ndarray
+
+
+class Adapting(NamedTuple):
+    """An EvoRBC controller's onboard adaptation (docs/design/adaptation.md).
+
+    Built by :func:`offline_evolution.maze_task.adapting.adapting`; the arrays are the
+    :class:`~evorbc_ros.adaptation.online.OnlineAdaptation`'s of the same repertoire.
+
+    Attributes:
+        conf, iconf: :func:`evorbc_ros.adaptation.online.settings_arrays`.
+        features, recorded, expected: ``(n, 3)`` the outcome model's.
+        weight: ``(3,)`` 1 / each outcome dimension's extent (1/m, 1/m, 1/rad).
+        noise: the model's noise variance over the prior's.
+        capacity: the ring's ``K``.
+        dt: s, the control period: cycle ``t``'s pose is stamped ``round(t dt 1e9)`` ns,
+            as the bridge stamps its odometry.
+    """
+
+    conf: np.ndarray
+    iconf: np.ndarray
+    features: np.ndarray
+    recorded: np.ndarray
+    expected: np.ndarray
+    weight: np.ndarray
+    noise: float
+    capacity: int
+    dt: float
 
 
 @nb.njit(cache=True)
@@ -230,6 +267,63 @@ def _decide(out, controller, lim, command):
     return choice
 
 
+@nb.njit(cache=True)
+def _adapt(t, x, y, h, out, controller, command, choice, adapt, ints, floats, model):
+    """The adapting controller's cycle ``t``: the grid's ``choice`` -> the primitive to run.
+
+    As :meth:`evorbc_ros.arbitration.Controller.step` with adaptation on, fed the pose
+    ``(x m, y m, h rad)`` at the cycle's start as the arbitrator node gets it from the
+    bridge's odometry (stamp, quaternion and back): the motion since the last choice goes
+    to the primitive chosen then, then the grid's choice is matched against the corrected
+    outcomes (at the centre of its grid cell) and ``command`` rewritten if another runs.
+    ``model``: the outcome model's arrays (:meth:`OutcomeModel.arrays` order) and noise.
+    """
+    z, w = _planar_quaternion(h)
+    _put_pose(ints, floats, round(t * adapt.dt * 1e9), x, y, _quaternion_yaw(0.0, 0.0, z, w))
+    (features, recorded, expected, kzx, slots, residual, inverse, alpha, correction,
+     corrected, counts, noise) = model  # fmt: skip
+    _before_choice(ints, floats, adapt.conf, adapt.iconf, features, recorded, expected,
+                   kzx, slots, residual, inverse, alpha, correction, corrected, counts,
+                   noise)  # fmt: skip
+    if choice != NO_PRIMITIVE:
+        px, py = map_point(controller.map_kind, controller.map_params, out[0], out[1])
+        nx, ny = controller.lookup_table.shape
+        o, c = controller.lookup_origin, controller.lookup_cell
+        # The cell's centre as evorbc_ros.mapping.PrimitiveLookup.cell_centre computes it.
+        cx = o[0] + (clamped_cell((px - o[0]) / c[0], nx) + 0.5) * c[0]
+        cy = o[1] + (clamped_cell((py - o[1]) / c[1], ny) + 0.5) * c[1]
+        chosen = _adapted_choice(adapt.iconf, cx, cy, choice, recorded, corrected, counts,
+                                 adapt.weight)  # fmt: skip
+        if chosen != choice:
+            choice = chosen
+            for k in range(command.shape[0]):
+                command[k] = controller.primitive_commands[choice, k]
+            if controller.speed_wheel_radius > 0.0:
+                command[0] = speed_through_wheels(command[0], controller.speed_wheel_radius)
+    _after_choice(ints, floats, adapt.conf, choice, features, recorded, expected, kzx, slots,
+                  residual, inverse, alpha, correction, corrected, counts, noise)  # fmt: skip
+    return choice
+
+
+@nb.njit(cache=True)
+def _new_model(adapt):
+    """An episode's adaptation state, as the onboard controller starts it.
+
+    The settled-cycle rule's ``(ints, floats)`` (:func:`evorbc_ros.adaptation.cycles.new_state`)
+    and the outcome model's arrays as :class:`~evorbc_ros.adaptation.model.OutcomeModel`
+    starts them, with its noise.
+    """
+    ints = np.zeros(adaptation_cycles.N_INTS, dtype=np.int64)
+    ints[adaptation_cycles.RUNNING] = -1
+    k = adapt.capacity
+    n = adapt.recorded.shape[0]
+    model = (adapt.features, adapt.recorded, adapt.expected, np.zeros((k, n)),
+             np.full(k, -1, dtype=np.int64), np.zeros((k, 3)), np.zeros((k, k)),
+             np.zeros((k, 3)), np.zeros((3, n)), adapt.recorded.copy(),
+             np.zeros(3, dtype=np.int64), adapt.noise)  # fmt: skip
+    return ints, np.zeros(adaptation_cycles.N_FLOATS), model
+
+
 @nb.njit(cache=True, inline="always")
 def _record(pose, choice_trace, output_trace, e, t, x, y, h, choice, out):
     """Write cycle ``t`` of episode ``e`` into the arrays of :class:`Traces`."""
@@ -280,7 +374,7 @@ def _unchanged(state, e, before):
 
 @nb.njit(cache=True, parallel=True)
 def run_episodes(
-    genome, maze, start, n_cycles, net, world, sensors, controller, lim, traces, draws
+    genome, maze, start, n_cycles, net, world, sensors, controller, lim, traces, draws, adapt
 ):
     """Run every episode ``e`` (genome ``genome[e]`` in maze ``maze[e]`` from ``start[e]``).
 
@@ -300,6 +394,9 @@ def run_episodes(
             ``STATE_SIZE`` columns, x, y and heading first).
         traces: :class:`Traces`, filled when ``traces.on``.
         draws: :class:`WorldDraws`, applied when ``draws.on``.
+        adapt: :class:`Adapting`: an EvoRBC controller adapts, each episode from the
+            prior; None: it does not. A compile-time choice (numba prunes the branches on
+            ``adapt is None``), so the kernel without adaptation is the one before it.
 
     Returns:
         ``(reached (E,) bool, cycles (E,) int64, final_distance (E,), initial_distance (E,),
@@ -355,6 +452,8 @@ def run_episodes(
         # (Rows past the episode's length are never written: a longer window reads p(0).)
         trail = np.empty((min(window, n_cycles) + 1, 2))
         still = 0  # cycles in a row whose step left the state unchanged
+        if adapt is not None:  # the episode's own rule state and outcome model
+            a_ints, a_floats, model = _new_model(adapt)
         initial_distance[e] = math.hypot(start[e, 0] - tx, start[e, 1] - ty)
         dist = initial_distance[e]
         for t in range(n_cycles):
@@ -364,6 +463,9 @@ def run_episodes(
             cand = _sense(t, x, y, h, m, world, sensors, trail, inputs, noise_sd, dropout, key)
             _think(g, t, inputs, values, buffers, recurrent, out, net)
             choice = _decide(out, controller, lim, command)
+            if adapt is not None:
+                choice = _adapt(t, x, y, h, out, controller, command, choice, adapt, a_ints,
+                                a_floats, model)  # fmt: skip
             if recording:
                 _record(pose, choice_trace, output_trace, e, t, x, y, h, choice, out)
             for k in range(STATE_SIZE):
@@ -377,7 +479,7 @@ def run_episodes(
                 reached[e] = True
                 cycles[e] = t + 1
                 break
-            if not recording and not drawn:
+            if not recording and not drawn and adapt is None:
                 # A fixed point: the whole state came back unchanged, so every later cycle
                 # reads the same sensors, gets the same outputs from the network and makes
                 # the same step. A feed-forward network is stateless; a recurrent one must
@@ -385,7 +487,9 @@ def run_episodes(
                 # step repeats this one. A motion input reads the same (0) only once the
                 # whole window, and the position this cycle compared with, hold this
                 # position: more than ``window`` unchanged steps in a row. The episode's
-                # outcome is already known: stop here.
+                # outcome is already known: stop here. Not while adapting: the motion
+                # summed so far is given to the model at the next unsettled cycle, which
+                # may change a later choice.
                 same = _unchanged(state, e, before)
                 still = still + 1 if same else 0
                 if same and recurrent:

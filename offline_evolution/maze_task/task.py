@@ -29,6 +29,7 @@ from offline_evolution.maze_task.base import (
 from offline_evolution.maze_task.kernel import (
     EVORBC,
     STANDARD,
+    Adapting,
     Traces,
     WorldDraws,
     run_episodes,
@@ -161,6 +162,17 @@ class MazeTask(MazeTaskBase):
         self._pieces = [maze_piece(m, self.reach) for m in self.mazes]
         self._generated_pieces: OrderedDict[str, MazePiece] = OrderedDict()
         self.pack = combine_pieces(self._pieces)
+        #: An EvoRBC controller's onboard adaptation in every episode (:meth:`adapt`), or
+        #: None: the evolved choices.
+        self.adapting: Adapting | None = None
+
+    def adapt(self, adapting: Adapting | None) -> None:
+        """Run EvoRBC episodes adapting, each from the prior; None: not.
+
+        ``adapting``: :func:`~offline_evolution.maze_task.adapting.adapting` of the
+        controller's repertoire.
+        """
+        self.adapting = adapting
 
     def mazes_changed(self, unchanged: int) -> None:
         """Repack for a new set of mazes: only mazes not packed before get new grids.
@@ -219,6 +231,14 @@ class MazeTask(MazeTaskBase):
             keys = np.tile(world.keys, len(genomes))
         else:
             params, keys = np.zeros((1, 7)), np.zeros(1, dtype=np.int64)
+        adapt = None
+        if self.adapting is not None and controller.mode == EVORBC:
+            adapt = self.adapting
+            n = len(controller.primitive_commands)
+            if len(adapt.recorded) != n:
+                raise ValueError(
+                    f"adaptation of {len(adapt.recorded)} primitives, controller of {n}"
+                )
         with numba.parallel_chunksize(_CHUNK):
             reached, cycles, final, initial, end = run_episodes(
                 genome,
@@ -232,6 +252,7 @@ class MazeTask(MazeTaskBase):
                 self.robot.limits,
                 Traces(bool(record), pose, choice, outputs),
                 WorldDraws(world is not None, params, keys),
+                adapt,
             )
         traces = (pose, choice, outputs) if record else None
         ends = (maze, start[:, :2], end)

@@ -53,6 +53,8 @@ class EvaluateRun:
     plot: str | None = None  # picture of the suite (PNG)
     out: str | None = None  # the report (JSON)
     allow_mismatch: bool = False  # another repertoire fingerprint or sensor layout
+    adapt: bool = False  # the suite again with the controller adapting onboard
+    adapt_expected: str = "recorded"  # what observations are compared with (or settled)
 
 
 @dataclass(frozen=True)
@@ -98,6 +100,7 @@ def _evaluate(run: EvaluateRun, report: Reporters) -> EvaluateOutcome:
     try:
         check_task(task, arb, arb_path, repertoire, rep_path, run.allow_mismatch)
         controller = task.controller(arb.kind, repertoire, arb.mapping)
+        adaptation = _adaptation(run, arb, task, repertoire)  # checked before any episode
         task.progress = report.episodes_done  # PyBullet suites take minutes
         try:
             suite = evaluate_suite(
@@ -105,6 +108,9 @@ def _evaluate(run: EvaluateRun, report: Reporters) -> EvaluateOutcome:
             )
         except ValueError as e:
             raise UserError(f"--perturb {run.perturb}: {e}") from None
+        adapted = None
+        if adaptation is not None:
+            adapted = _adapted_suite(run, arb, task, controller, perturbation, *adaptation)
     finally:
         task.close()
     if suite.not_applicable:
@@ -134,12 +140,63 @@ def _evaluate(run: EvaluateRun, report: Reporters) -> EvaluateOutcome:
         # Per damaged wheel, leg or side, for a set with damage (docs/perturbations.md).
         **({"per_damage": suite.per_damage()} if perturbation.damage else {}),
         "episodes": [e.as_dict() for e in suite.episodes],
+        **({"adaptation": adapted} if adapted else {}),
     }
     if run.out:
         atomic_write_text(run.out, json.dumps(data, indent=1) + "\n")
     if run.plot:
         _plot(task, suite, run.plot, f"{arb_path.name}, perturbations: {perturbation.name}")
     return EvaluateOutcome(data, arb_path, arb, perturbation.name)
+
+
+def _adaptation(run: EvaluateRun, arb, task, repertoire):
+    """``--adapt``: ``(settings, kernel arrays)`` of the controller adapting; None without.
+
+    Raises:
+        UserError: a standard controller, a robot whose episodes do not adapt, or
+            ``--adapt-expected settled`` for a robot that is not 4WS.
+    """
+    if not run.adapt:
+        return None
+    from evorbc_ros.adaptation import AdaptationSettings
+    from offline_evolution.maze_task.adapting import adapting, expected_outcomes
+
+    if not arb.kind.uses_repertoire:
+        raise UserError("--adapt: adaptation corrects a repertoire; this is a standard controller")
+    if not hasattr(task, "adapt"):
+        raise UserError(f"--adapt: {arb.robot}'s episodes do not adapt yet (4WS and "
+                        "differential-drive robots do; docs/design/adaptation.md)")  # fmt: skip
+    settings = AdaptationSettings()
+    try:
+        expected = expected_outcomes(repertoire, task.robot, run.adapt_expected)
+    except ValueError as e:
+        raise UserError(f"--adapt-expected {run.adapt_expected}: {e}") from None
+    return settings, adapting(repertoire, settings, task.dt, expected)
+
+
+def _adapted_suite(run, arb, task, controller, perturbation, settings, arrays) -> dict:
+    """The same episodes (starts, worlds) with the controller adapting, each from the prior.
+
+    Returns the report's ``adaptation`` section: the settings, the figures as without, and
+    each episode as without (in the same order, so that its reach compares one to one).
+    """
+    from dataclasses import asdict
+
+    from offline_evolution.maze_task.evaluation import evaluate_suite
+
+    task.adapt(arrays)
+    try:
+        suite = evaluate_suite(task, arb.network, controller, run.starts, run.seed, perturbation)
+    finally:
+        task.adapt(None)
+    return {
+        "settings": asdict(settings),
+        "expected": run.adapt_expected,
+        "per_maze": suite.per_maze(),
+        "overall": suite.overall(),
+        **({"per_damage": suite.per_damage()} if perturbation.damage else {}),
+        "episodes": [e.as_dict() for e in suite.episodes],
+    }
 
 
 def _suite_task(run: EvaluateRun, arb: ArbitratorFile, base):

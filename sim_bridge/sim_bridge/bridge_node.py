@@ -303,9 +303,14 @@ class SimBridgeNode(Node):
     # -- running -----------------------------------------------------------------------
 
     def missing(self) -> list[str]:
-        """The graph topics that have no subscriber or publisher (a node is down)."""
-        out = [t for t in self.wait_subscribers if self.count_subscribers(t) == 0]
-        return out + [t for t in self.wait_publishers if self.count_publishers(t) == 0]
+        """The graph topics that lack a subscriber or publisher (a node is down).
+
+        A topic named ``k`` times needs ``k`` of them: an adapting arbitrator subscribes
+        ``odom`` beside the radar node, and a first state it missed would be sent again.
+        """
+        subs, pubs = self.wait_subscribers, self.wait_publishers
+        out = [t for t in dict.fromkeys(subs) if self.count_subscribers(t) < subs.count(t)]
+        return out + [t for t in dict.fromkeys(pubs) if self.count_publishers(t) < pubs.count(t)]
 
     def endpoints(self) -> frozenset:
         """The graph's endpoints the bridge waits on: ``(topic, endpoint GID)`` pairs.

@@ -53,7 +53,8 @@ PARAMETERS = (
     spec(
         "wait_for_subscribers",
         ("scan", "odom"),
-        "topics that need a subscriber before the run starts",
+        "topics that need a subscriber before the run starts (a topic named k times: k "
+        "subscribers, e.g. odom twice for an adapting arbitrator beside the radar node)",
     ),
     spec(
         "wait_for_publishers",

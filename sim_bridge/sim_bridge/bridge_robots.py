@@ -13,13 +13,13 @@ docs/your-robot.md gives the adapter's interface).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from evorbc_ros.nodes.common import StartupError, robot_named
 from evorbc_ros.robots.registry import RobotError
+from sim_bridge.geometry import planar_quaternion
 from sim_bridge.perturbation import WorldDraw
 from sim_bridge.robots.adapters import bridge_class
 from sim_bridge.world import LaserConfig
@@ -72,7 +72,7 @@ class KinematicBridge:
     def body_pose(self) -> tuple[tuple, tuple]:
         """Position (m) and orientation (xyzw) of ``base_link`` in ``odom``: planar."""
         x, y, h = self.world.pose
-        return (x, y, 0.0), (0.0, 0.0, math.sin(0.5 * h), math.cos(0.5 * h))
+        return (x, y, 0.0), (0.0, 0.0, *planar_quaternion(h))
 
 
 def bridge_robot_class(robot: str) -> type:

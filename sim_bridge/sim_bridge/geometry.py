@@ -260,3 +260,12 @@ def box_distances(px: np.ndarray, py: np.ndarray, box: np.ndarray) -> np.ndarray
     du = np.maximum(np.abs(qx * box[EX] + qy * box[EY]) - box[HALF_LENGTH], 0.0)
     dv = np.maximum(np.abs(-qx * box[EY] + qy * box[EX]) - box[HALF_THICKNESS], 0.0)
     return np.hypot(du, dv)
+
+
+def planar_quaternion(h: float) -> tuple[float, float]:
+    """``(z, w)`` of the orientation quaternion of heading ``h`` (rad about z; x = y = 0).
+
+    What the bridge publishes in ``odom``; numba compiles it to the same bits, so the
+    offline kernel's adapting controller reads the yaw the arbitrator node reads.
+    """
+    return math.sin(0.5 * h), math.cos(0.5 * h)

@@ -141,6 +141,67 @@ def nearest_outcome(outcomes: np.ndarray, target: np.ndarray, weight: np.ndarray
     return int(np.argmin(e0 * e0 + e1 * e1 + e2 * e2))
 
 
+#: Rows of a model's ``counts`` (int64 ``(3,)``): slots in use, the ring's next slot, and
+#: observations taken since the last reset.
+USED, NEXT_SLOT, OBSERVATIONS = 0, 1, 2
+
+
+def observe(
+    features,
+    recorded,
+    expected,
+    kzx,
+    slots,
+    residual,
+    inverse,
+    alpha,
+    correction,
+    corrected,
+    counts,
+    noise,
+    index,
+    o0,
+    o1,
+    o2,
+):
+    """Take what primitive ``index`` did, ``(o0 m, o1 m, o2 rad)`` over ``T``, and refit.
+
+    A primitive already in the ring has its slot's residual replaced (the latest
+    observation stands; its kernel row is unchanged); another takes ``counts[NEXT_SLOT]``,
+    pushing out the oldest when the ring of ``K = len(slots)`` is full.
+
+    Args:
+        features, recorded, expected: ``(n, 3)`` (see the module and
+            :class:`~evorbc_ros.adaptation.model.OutcomeModel`).
+        kzx, slots, residual, inverse, alpha, correction: as :func:`refit`, updated.
+        corrected: ``(n, 3)`` written: ``recorded`` plus the correction (m, m, rad).
+        counts: ``(3,)`` int64 ``[USED, NEXT_SLOT, OBSERVATIONS]``, updated.
+        noise: as :func:`refit`.
+    """
+    used = counts[USED]
+    s = -1
+    for k in range(used):
+        if slots[k] == index:
+            s = k
+            break
+    if s < 0:
+        s = counts[NEXT_SLOT]
+        counts[NEXT_SLOT] = (s + 1) % slots.shape[0]
+        used = max(used, s + 1)
+        counts[USED] = used
+        slots[s] = index
+        kernel_row(features, index, kzx[s])
+    residual[s, 0] = o0 - expected[index, 0]
+    residual[s, 1] = o1 - expected[index, 1]
+    residual[s, 2] = o2 - expected[index, 2]
+    counts[OBSERVATIONS] += 1
+    refit(kzx, slots, residual, used, noise, inverse, alpha, correction)
+    # Whole columns: one IEEE addition per element either way, and plain numpy pays per
+    # call, not per element (as a loop over elements it cost 9 ms a refit at 10,000).
+    for c in range(3):
+        corrected[:, c] = recorded[:, c] + correction[c]
+
+
 #: The functions above, callees first (each may call only those before it).
 FUNCTIONS = (
     "wendland",
@@ -150,6 +211,7 @@ FUNCTIONS = (
     "variance",
     "nearest",
     "nearest_outcome",
+    "observe",
 )
 
 
@@ -163,13 +225,30 @@ def compiled(jit) -> dict:
     Returns:
         name -> compiled function, for every name in :data:`FUNCTIONS`.
     """
+    return compile_together(jit, globals(), FUNCTIONS)
+
+
+def compile_together(jit, space: dict, names, plain: dict | None = None) -> dict:
+    """Compile the functions ``names`` (callees first), each calling the others' compiled forms.
+
+    Args:
+        jit: ``numba.njit`` or one with options.
+        space: the globals the clones see (copied; the compiled functions replace the
+            plain ones in it by name).
+        names: the functions' names, callees first.
+        plain: name -> plain function (default: ``space``'s).
+
+    Returns:
+        name -> compiled function.
+    """
     import types
 
-    space = dict(globals())
+    space = dict(space)
+    plain = space if plain is None else plain
     out = {}
-    for name in FUNCTIONS:
-        plain = globals()[name]
-        clone = types.FunctionType(plain.__code__, space, name, plain.__defaults__)
-        clone.__doc__ = plain.__doc__
+    for name in names:
+        fn = plain[name]
+        clone = types.FunctionType(fn.__code__, space, name, fn.__defaults__)
+        clone.__doc__ = fn.__doc__
         out[name] = space[name] = jit(clone)
     return out

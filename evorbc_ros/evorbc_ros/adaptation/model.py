@@ -120,9 +120,19 @@ class OutcomeModel:
         self.alpha = np.zeros((k, 3))
         self.correction = np.zeros((3, n))
         self.corrected = self.recorded.copy()
-        self.used = 0  # slots holding an observation
-        self.next_slot = 0  # where the next new primitive goes (a ring)
-        self.observations = 0  # observations taken since the last reset
+        #: ``[used, next_slot, observations]`` (:data:`gp.USED` ...): int64, so that the
+        #: compiled :func:`gp.observe` updates them in place.
+        self.counts = np.zeros(3, dtype=np.int64)
+
+    @property
+    def used(self) -> int:
+        """Slots holding an observation."""
+        return int(self.counts[gp.USED])
+
+    @property
+    def observations(self) -> int:
+        """Observations taken since the last reset."""
+        return int(self.counts[gp.OBSERVATIONS])
 
     def __len__(self) -> int:
         return len(self.recorded)
@@ -133,37 +143,33 @@ class OutcomeModel:
         self.residual[:] = 0.0
         self.correction[:] = 0.0
         self.corrected[:] = self.recorded
-        self.used = self.next_slot = self.observations = 0
+        self.counts[:] = 0
+
+    def arrays(self) -> tuple:
+        """The arrays :func:`gp.observe` takes, in its order, up to ``counts``."""
+        return (
+            self.features,
+            self.recorded,
+            self.expected,
+            self.kzx,
+            self.slots,
+            self.residual,
+            self.inverse,
+            self.alpha,
+            self.correction,
+            self.corrected,
+            self.counts,
+        )
 
     def observe(self, index: int, outcome: np.ndarray) -> None:
         """Take what primitive ``index`` did, as ``(dx, dy, dheading)`` over ``T``.
 
         A primitive already in the ring has its slot's residual replaced (the latest
         observation stands; its kernel column is unchanged); another takes the next slot,
-        pushing out the oldest when the ring is full.
+        pushing out the oldest when the ring is full (:func:`gp.observe`).
         """
-        found = np.flatnonzero(self.slots[: self.used] == index)
-        if len(found):
-            s = int(found[0])
-        else:
-            s = self.next_slot
-            self.next_slot = (s + 1) % self.settings.capacity
-            self.used = max(self.used, s + 1)
-            self.slots[s] = index
-            self.gp["kernel_row"](self.features, index, self.kzx[s])
-        self.residual[s] = np.asarray(outcome, np.float64) - self.expected[index]
-        self.observations += 1
-        self.gp["refit"](
-            self.kzx,
-            self.slots,
-            self.residual,
-            self.used,
-            self.settings.noise,
-            self.inverse,
-            self.alpha,
-            self.correction,
-        )
-        np.add(self.recorded, self.correction.T, out=self.corrected)
+        o0, o1, o2 = (float(v) for v in outcome)
+        self.gp["observe"](*self.arrays(), self.settings.noise, int(index), o0, o1, o2)
 
     def nearest(self, x: float, y: float) -> int:
         """The primitive whose corrected ``(dx, dy)`` is nearest the point ``(x, y)`` (m)."""

@@ -12,6 +12,23 @@ from __future__ import annotations
 import math
 
 
+def remainder(x, y):
+    """IEEE 754 ``remainder(x, y)`` for finite ``x`` and ``y > 0``: ``math.remainder``'s bits.
+
+    numba has no ``math.remainder`` (nor ``fmod``). ``%`` of positive numbers is ``fmod``,
+    exact, and each subtraction below is of two numbers within a factor of two of each
+    other (Sterbenz), so exact too; reducing modulo ``2 y`` first keeps the quotient's
+    parity, which decides a tie (to even).
+    """
+    r = abs(x) % (2.0 * y)  # in [0, 2y): fmod of positive numbers, exact
+    half = 0.5 * y
+    if r > half:
+        r = r - y  # in (-y/2, y)
+        if r >= half:  # at y/2 exactly the quotient 2 (even) wins over 1
+            r = r - y
+    return math.copysign(r, x) if r == 0.0 else (r if x >= 0.0 else -r)
+
+
 def relative_motion(x0, y0, h0, x1, y1, h1):
     """The motion from pose 0 to pose 1 in pose 0's frame: ``(dx m, dy m, dheading rad)``.
 
@@ -22,7 +39,7 @@ def relative_motion(x0, y0, h0, x1, y1, h1):
     s = math.sin(h0)
     ex = x1 - x0
     ey = y1 - y0
-    dh = math.remainder(h1 - h0, 2.0 * math.pi)
+    dh = remainder(h1 - h0, 2.0 * math.pi)
     return c * ex + s * ey, -s * ex + c * ey, dh
 
 

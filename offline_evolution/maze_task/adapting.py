@@ -1,0 +1,75 @@
+"""Offline episodes with the onboard controller's adaptation (docs/design/adaptation.md).
+
+:func:`adapting` builds the episode kernel's :class:`~offline_evolution.maze_task.kernel.Adapting`
+from a repertoire exactly as :meth:`evorbc_ros.arbitration.Controller.enable_adaptation`
+builds its :class:`~evorbc_ros.adaptation.online.OnlineAdaptation`: the same recorded
+outcomes, GP inputs, weights and settings arrays, so the kernel, running the same
+functions compiled, takes the same observations and chooses the same primitives as the
+arbitrator node in a lockstep graph.
+
+What an observation is compared with (``expected``): ``recorded``, the repertoire's
+outcomes, which is what the arbitrator node uses; or ``settled``, what each primitive does
+once the 4WS model's actuators hold its command
+(:func:`sim_bridge.four_ws.steady.settled_outcomes`), which does not mistake the recorded
+ramp for damage.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from evorbc_ros.adaptation import AdaptationSettings, outcome_table
+from evorbc_ros.adaptation.model import OutcomeModel
+from evorbc_ros.adaptation.online import settings_arrays
+from evorbc_ros.repertoire import Repertoire
+from offline_evolution.maze_task.kernel import Adapting
+
+#: What an observation is compared with.
+EXPECTED = ("recorded", "settled")
+
+
+def expected_outcomes(repertoire: Repertoire, robot, expected: str) -> np.ndarray | None:
+    """``(n, 3)`` what each primitive's settled cycles should read, or None (recorded).
+
+    Raises:
+        ValueError: ``settled`` for a robot that is not 4WS, or an unknown ``expected``.
+    """
+    if expected not in EXPECTED:
+        raise ValueError(f"adaptation expected must be one of {', '.join(EXPECTED)}")
+    if expected == "recorded":
+        return None
+    from sim_bridge.four_ws.motion import MotionLimits
+    from sim_bridge.four_ws.steady import settled_outcomes
+
+    if not isinstance(robot.limits, MotionLimits):
+        raise ValueError(f"adaptation expected settled: only for 4WS robots, not {robot.name}")
+    return settled_outcomes(robot.commands(repertoire.genes), robot.limits, repertoire.eval_time)
+
+
+def adapting(
+    repertoire: Repertoire,
+    settings: AdaptationSettings,
+    dt: float,
+    expected: np.ndarray | None = None,
+) -> Adapting:
+    """The kernel's adaptation of an EvoRBC controller of ``repertoire``.
+
+    Args:
+        settings: the model's and the settled-cycle rule's.
+        dt: s, the robot's control period (the odometry's stamps).
+        expected: ``(n, 3)`` (:func:`expected_outcomes`); None: the recorded outcomes.
+    """
+    recorded = outcome_table(repertoire.behaviour, repertoire.heading)
+    model = OutcomeModel(recorded, settings, expected)
+    conf, iconf = settings_arrays(model.recorded, repertoire.eval_time, settings)
+    return Adapting(
+        conf,
+        iconf,
+        model.features,
+        model.recorded,
+        np.ascontiguousarray(model.expected),
+        np.ascontiguousarray(model.weight, dtype=np.float64),
+        float(settings.noise),
+        int(settings.capacity),
+        float(dt),
+    )

@@ -1,0 +1,110 @@
+"""The offline episodes with the onboard controller's adaptation (docs/design/adaptation.md).
+
+The episode kernel runs the same adaptation code as the arbitrator node (the settled-cycle
+rule, the GP correction, the matching), compiled: the lockstep graph, the arbitrator node
+adapting, drives a damaged 4WS robot exactly as the adapted offline episode, bit for bit.
+``evaluate --adapt`` reports each episode with and without adaptation.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from evorbc_ros.adaptation import AdaptationSettings
+from evorbc_ros.arbitrator import ArbitratorFile
+from evorbc_ros.defaults import default_arbitrator, default_repertoire
+from evorbc_ros.repertoire import Repertoire
+from offline_evolution.cli import main
+from offline_evolution.maze_task.adapting import adapting, expected_outcomes
+from offline_evolution.maze_task.base import MazeTaskSettings
+from offline_evolution.maze_task.task import MazeTask
+from sim_bridge.perturbation import load_perturbations
+
+
+def _gaps_task(episode_time=25.0):
+    path = default_arbitrator()
+    arb = ArbitratorFile.load(path)
+    sensors = MazeTaskSettings.from_dict(arb.evolution["task"], str(path)).sensors
+    task = MazeTask(MazeTaskSettings(("gaps",), episode_time, 1, sensors), arb.robot)
+    rep = Repertoire.load(default_repertoire())
+    return path, arb, task, rep, task.controller("evorbc", rep, arb.mapping)
+
+
+def test_the_kernel_adapts_deterministically_and_changes_choices_only_when_on():
+    _, arb, task, rep, controller = _gaps_task()
+    starts = task.nominal_starts()
+    world = load_perturbations("4ws-stuck-steering").draw(np.random.default_rng([4, 1]), 1)
+    off = task.evaluate([arb.network], controller, starts, record=True, world=world)
+    for expected in ("recorded", "settled"):
+        expected_rows = expected_outcomes(rep, task.robot, expected)
+        task.adapt(adapting(rep, AdaptationSettings(), task.dt, expected_rows))
+        on = task.evaluate([arb.network], controller, starts, record=True, world=world)
+        again = task.evaluate([arb.network], controller, starts, record=True, world=world)
+        np.testing.assert_array_equal(on.pose, again.pose)  # each episode from the prior
+        np.testing.assert_array_equal(on.choice, again.choice)
+        n = min(on.cycles[0], off.cycles[0])
+        assert (on.choice[0, :n] != off.choice[0, :n]).any()
+        # Until an observation is taken, the adapted controller chooses as the evolved one.
+        assert on.choice[0, 0] == off.choice[0, 0]
+        task.adapt(None)
+    back = task.evaluate([arb.network], controller, starts, record=True, world=world)
+    np.testing.assert_array_equal(back.pose, off.pose)
+
+
+def test_the_lockstep_graph_adapting_drives_a_damaged_robot_as_the_offline_episode(tmp_path):
+    # The arbitrator node with its adaptation parameter on (recorded outcomes as expected,
+    # as the node has no others) against the kernel's adapted episode, with a stuck
+    # steering wheel: the same primitive at every cycle and the same poses, bit for bit.
+    from graph_helpers import GraphRun, assert_same_choices
+
+    path, arb, task, rep, controller = _gaps_task()
+    starts = task.nominal_starts()
+    world = load_perturbations("4ws-stuck-steering").draw(np.random.default_rng([4, 1]), 1)
+    plain = task.evaluate([arb.network], controller, starts, record=True, world=world)
+    task.adapt(adapting(rep, AdaptationSettings(), task.dt))
+    result = task.evaluate([arb.network], controller, starts, record=True, world=world)
+    # odom twice: the bridge starts once the adapting arbitrator has subscribed it too
+    # (a first pose it missed would be sent again, and the other nodes answer twice).
+    bridge = {"perturb": "4ws-stuck-steering", "seed": 4,
+              "wait_for_subscribers": ["scan", "odom", "odom"]}  # fmt: skip
+    run = GraphRun(tmp_path, 187, "gaps", episode_time=25.0, arbitrator=path, bridge=bridge,
+                   arbitrator_params={"adaptation": True})  # fmt: skip
+    got = run.finish(timeout=120)
+    choices = run.recorded_choices()
+    cycles = assert_same_choices(choices, result)
+    trajectory = np.array(got["trajectory"])
+    np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
+    n = min(cycles, plain.cycles[0])
+    assert (choices[:n] != plain.choice[0, :n]).any()  # adaptation changed the choices
+    log = (tmp_path / "gaps-lockstep.log").read_text()
+    assert "adaptation on" in log and "stuck_steering: " in log
+
+
+def test_evaluate_adapt_reports_each_episode_with_and_without(tmp_path, capsys):
+    out = tmp_path / "report.json"
+    args = ["evaluate", "--mazes", "gaps", "--starts", "2", "--perturb", "4ws-stuck-steering",
+            "--adapt", "--out", str(out)]  # fmt: skip
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "with adaptation (expected: recorded):" in text
+    assert "with adaptation, by damaged part (stuck_steering):" in text
+    report = json.loads(out.read_text())
+    adapted = report["adaptation"]
+    assert adapted["settings"]["match"] == "outcome" and adapted["expected"] == "recorded"
+    assert len(adapted["episodes"]) == len(report["episodes"]) == 2
+    for off, on in zip(report["episodes"], adapted["episodes"], strict=True):
+        assert on["start"] == off["start"] and on["damage"] == off["damage"]
+    assert adapted["per_damage"] and adapted["overall"]["episodes"] == 2
+    assert main(["evaluate", "--mazes", "gaps", "--starts", "1", "--json"]) == 0
+    assert "adaptation" not in json.loads(capsys.readouterr().out)  # only with --adapt
+
+
+def test_evaluate_adapt_refuses_what_cannot_adapt_in_one_line(capsys):
+    assert main(["evaluate", "--robot", "hexapod", "--starts", "1", "--adapt"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.endswith(
+        "--adapt: hexapod's episodes do not adapt yet (4WS and differential-drive robots do; "
+        "docs/design/adaptation.md)"
+    )
