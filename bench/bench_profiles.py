@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import platform
 import subprocess
@@ -33,12 +34,23 @@ def stage_times(out: Path) -> dict:
     return json.loads(path.read_text()) if path.is_file() else {}
 
 
-def evaluations(out: Path) -> int | None:
-    """The repertoire step's evaluations, from the repertoire file it wrote."""
+def repertoire_figures(out: Path) -> dict:
+    """The repertoire the run wrote: evaluations, primitives, and how far its primitives
+    go in the evaluation time T (m: median and 90th percentile of the displacement, the
+    largest forward one), which bounds how fast an arbitrator can cross a maze."""
     for path in sorted(out.glob("*.repertoire.json")):
         data = json.loads(path.read_text())
-        return (data.get("evolution") or {}).get("evaluations")
-    return None
+        behaviour = data["primitives"]["behaviour"]
+        reach = sorted(math.hypot(x, y) for x, y in behaviour)
+        return {
+            "evaluations": data["algorithm"].get("evaluations"),
+            "primitives": len(reach),
+            "eval_time_s": data["eval_time"],
+            "displacement_p50_m": round(reach[len(reach) // 2], 3),
+            "displacement_p90_m": round(reach[int(0.9 * (len(reach) - 1))], 3),
+            "forward_max_m": round(max(x for x, _ in behaviour), 3),
+        }
+    return {}
 
 
 def reach(arbitrator: Path, robot_path: str, extra: list[str]) -> dict:
@@ -79,11 +91,11 @@ def main(argv: list[str] | None = None) -> int:
         "load_after": os.getloadavg(),
         "this_run_wall_s": round(time.perf_counter() - started, 1),
         "stages": stage_times(args.out),
-        "repertoire_evaluations": evaluations(args.out),
+        "repertoire": repertoire_figures(args.out),
     }
-    rep = figures["stages"].get("repertoire")
-    if rep and figures["repertoire_evaluations"]:
-        figures["evaluations_per_s"] = round(figures["repertoire_evaluations"] / rep["wall_s"], 1)
+    rep, made = figures["stages"].get("repertoire"), figures["repertoire"]
+    if rep and made.get("evaluations"):
+        figures["evaluations_per_s"] = round(made["evaluations"] / rep["wall_s"], 1)
     print(f"{args.source} at the {args.profile} profile ({figures['machine']})")
     total = 0.0
     for step, t in figures["stages"].items():
