@@ -71,8 +71,8 @@ def test_the_graph_drives_the_scaled_maze_exactly_as_offline(tmp_path, controlle
     # recorded; this graph leaves it to the bridge, which fits the maze as offline did.
     bridge = sim_graph(robot="husky", maze=MAZE, arbitrator=str(arb_path)).node("sim_bridge")
     assert bridge.parameters["maze_scale"] == FACTOR
-    # Its rangefinders reach 3.6 m from the centre: the scan must too (docs/design.md s. 9).
-    assert bridge.parameters["laser_range"] == 3.6
+    # Its rangefinders reach 5.9 m from the centre: the scan must too (docs/design.md s. 9).
+    assert bridge.parameters["laser_range"] == pytest.approx(5.9)
     run = GraphRun(
         tmp_path,
         DOMAIN,
