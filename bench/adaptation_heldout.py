@@ -11,8 +11,8 @@ docs/design/adaptation.md: reach and mean time to the target without and with ad
 against the issue's targets, per damaged wheel, how many observations the episodes took,
 and the reach as a function of elapsed time. ``--out FILE.json`` writes the figures
 (docs/results/adaptation/); ``--pictures DIR`` draws the paths of one maze before and after
-adaptation under a stuck steering wheel and that episode's corrected outcome map
-(:mod:`offline_evolution.plots.adaptation`).
+adaptation under a stuck steering wheel, that episode's corrected outcome map and the
+execution error over elapsed time per set (:mod:`offline_evolution.plots.adaptation`).
 
     python bench/adaptation_heldout.py [--expected recorded] [--sets none ...]
         [--out docs/results/adaptation/heldout-recorded.json] [--pictures docs/]
@@ -252,6 +252,10 @@ def main() -> None:
             for path in draw_pictures(runs, replays, args.pictures):
                 print(f"wrote {path}")
     print_tables(results)
+    if args.pictures:
+        from offline_evolution.plots.adaptation import save_error_over_time
+
+        print(f"wrote {save_error_over_time(WINDOWS, results, args.pictures)}")
     if args.out:
         text = json.dumps({"expected": args.expected, "sets": results}, indent=1)
         atomic_write_text(args.out, text + "\n")

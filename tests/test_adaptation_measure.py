@@ -83,3 +83,23 @@ def test_settled_outcomes_of_a_slower_or_damaged_robot():
     left = settled_outcomes(ahead, robot.limits, rep.eval_time, damage=np.array([slow, 2, 0.2]))
     right = settled_outcomes(ahead, robot.limits, rep.eval_time, damage=np.array([slow, 1, 0.2]))
     assert left[0, 2] > 0.05 and right[0, 2] < -0.05 and left[0, 0] < straight[0, 0]
+
+
+def test_the_pictures_are_drawn_small(tmp_path):
+    from offline_evolution.plots.adaptation import draw_pictures, save_error_over_time
+
+    run = EvaluateRun(mazes=["gaps"], starts=2, perturb="4ws-stuck-steering", adapt=True)
+    runs = run_suites(run, Reporters([]))
+    task, rep = runs.task, runs.repertoire
+    controller = task.controller(runs.arbitrator.kind, rep, runs.arbitrator.mapping)
+    replays = [
+        replay_model(rep, controller, runs.settings, None, task.dt, p, c, o)
+        for p, c, o in zip(runs.adapted.paths, runs.adapted.choices, runs.adapted.outputs,
+                           strict=True)
+    ]  # fmt: skip
+    paths = draw_pictures(runs, replays, tmp_path)
+    errors = {"off": [0.2, 0.25], "on": [0.2, 0.1], "best": [0.06, 0.06]}
+    sets = [{"set": "none", "execution_error": errors}, {"set": "x", "execution_error": errors}]
+    paths.append(save_error_over_time(((0, 5), (5, 10)), sets, tmp_path))
+    for path in paths:
+        assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size < 200_000

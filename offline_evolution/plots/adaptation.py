@@ -21,6 +21,7 @@ from .suite import MISSED_COLOUR, REACHED_COLOUR
 
 PATHS_PNG = "adaptation-paths.png"
 MAP_PNG = "adaptation-outcome-map.png"
+ERROR_PNG = "adaptation-error-over-time.png"
 
 
 def paths_figure(maze, off_paths, off_reached, on_paths, on_reached, title: str = ""):
@@ -78,6 +79,45 @@ def outcome_map_figure(recorded: np.ndarray, corrected: np.ndarray, observed, ti
     if title:
         ax.set_title(title, fontsize=8)
     return fig
+
+
+def error_over_time_figure(windows, sets: list[dict], intact: list[float] | None):
+    """Per set, the execution error over elapsed time without and with adaptation.
+
+    Args:
+        windows: ``((t0, t1), ...)`` s, the windows the errors are means over.
+        sets: per set ``{"set": name, "execution_error": {"off": [...], "on": [...],
+            "best": [...]}}`` (one value per window, share of the repertoire's extent).
+        intact: the intact robot's error without adaptation per window, drawn in each
+            panel (None: not measured).
+    """
+    mid = [0.5 * (a + b) for a, b in windows]
+    fig, axes = plt.subplots(1, len(sets), figsize=(2.4 * len(sets), 2.6), sharey=True,
+                             layout="constrained", squeeze=False)  # fmt: skip
+    for ax, r in zip(axes[0], sets, strict=True):
+        x = r["execution_error"]
+        ax.plot(mid, x["off"], "o-", color="tab:orange", markersize=3, label="without")
+        ax.plot(mid, x["on"], "o-", color="tab:blue", markersize=3, label="with adaptation")
+        ax.plot(mid, x["best"], ":", color="tab:green", label="best primitive")
+        if intact is not None:
+            ax.plot(mid, intact, "--", color="0.4", label="intact, without")
+        ax.set_title(r["set"], fontsize=8)
+        ax.set_xlabel("elapsed time (s)", fontsize=7)
+        ax.set_xscale("log")
+        ax.tick_params(labelsize=6)
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_ylabel("execution error (share of extent)", fontsize=7)
+    axes[0, 0].legend(fontsize=6)
+    return fig
+
+
+def save_error_over_time(windows, sets: list[dict], folder: str | os.PathLike) -> Path:
+    """Save :func:`error_over_time_figure` of the damaged sets as :data:`ERROR_PNG`."""
+    intact = next((r["execution_error"]["off"] for r in sets if r["set"] == "none"), None)
+    path = Path(folder) / ERROR_PNG
+    damaged = [r for r in sets if r["set"] != "none"]
+    save_figure(error_over_time_figure(windows, damaged, intact), path, dpi=FIGURE_DPI)
+    return path
 
 
 def draw_pictures(runs, replays, folder: str | os.PathLike) -> list[Path]:
