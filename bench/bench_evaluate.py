@@ -14,8 +14,14 @@ prints episodes per second, with the episodes alone and the measures apart:
 
 Also the whole command in a fresh process (imports, maze generation, report, no picture).
 
+``--adapt``: instead, the evaluation with onboard adaptation on against off
+(``evaluate --adapt``, docs/design/adaptation.md): the shipped 4ws-5 controller on
+``--generated`` held-out mazes x ``--starts``, intact and with a stuck steering wheel,
+``--rounds`` rounds alternating off and on (the machine's load changes between them).
+Adapted episodes reach more often, so they run fewer cycles: compare control cycles/s.
+
 Run: ``.venv/bin/python bench/bench_evaluate.py [--starts 20] [--generated 50]
-[--hexapod-starts 8] [--hexapod-generated 2]``.
+[--hexapod-starts 8] [--hexapod-generated 2] [--adapt [--rounds 3]]``.
 """
 
 from __future__ import annotations
@@ -134,6 +140,38 @@ def hexapod(starts: int, generated: int) -> None:
             task.close()
 
 
+def adapting_4ws(starts: int, generated: int, rounds: int) -> None:
+    """Evaluation throughput with adaptation off and on (the best of ``rounds``)."""
+    from evorbc_ros.adaptation import AdaptationSettings
+    from evorbc_ros.defaults import default_arbitrator
+    from offline_evolution.maze_task.adapting import adapting
+
+    arb = ArbitratorFile.load(default_arbitrator("4ws-5"))
+    repertoire = Repertoire.load(default_repertoire("4ws-5"))
+    with tempfile.TemporaryDirectory() as tmp:
+        files = held_out_files("4ws-5", generated, tmp)
+        settings = MazeTaskSettings.from_dict(arb.evolution["task"], "shipped")
+        task = make_task(MazeTaskSettings(files, 120.0, 1, settings.sensors), "4ws-5")
+        arrays = adapting(repertoire, AdaptationSettings(), task.dt)
+        for adapt in (None, arrays):  # compile / load the JIT caches
+            task.adapt(adapt)
+            timed_suite(task, arb, repertoire, 1, NONE)
+        for pset in (NONE, load_perturbations("4ws-stuck-steering")):
+            best = {}
+            for _ in range(rounds):
+                for name, adapt in (("off", None), ("on", arrays)):
+                    task.adapt(adapt)
+                    total, alone, cycles = timed_suite(task, arb, repertoire, starts, pset)
+                    if name not in best or cycles / alone > best[name][2] / best[name][1]:
+                        best[name] = (total, alone, cycles)
+            task.adapt(None)
+            for name, figures in best.items():
+                label = f"4ws-5, {generated} held-out x {starts}, {pset.name}, adapt {name}"
+                report(label, generated * starts, *figures)
+            ratio = (best["on"][2] / best["on"][1]) / (best["off"][2] / best["off"][1])
+            print(f"  control cycles/s with adaptation on / off: {ratio:.2f}")
+
+
 def command(args: list[str]) -> float:
     """Wall seconds of ``evorbc-evolve ARGS`` in a fresh process."""
     exe = Path(sys.executable).with_name("evorbc-evolve")
@@ -148,8 +186,14 @@ def main() -> None:
     parser.add_argument("--generated", type=int, default=50)
     parser.add_argument("--hexapod-starts", type=int, default=8)
     parser.add_argument("--hexapod-generated", type=int, default=2)
+    parser.add_argument("--adapt", action="store_true", help="adaptation on against off")
+    parser.add_argument("--rounds", type=int, default=3)
     args = parser.parse_args()
     print(f"machine: {machine()}, load average {os.getloadavg()[0]:.1f}")
+    if args.adapt:
+        adapting_4ws(args.starts, args.generated, args.rounds)
+        print(f"load average at the end {os.getloadavg()[0]:.1f}")
+        return
     four_ws(args.starts, args.generated)
     hexapod(args.hexapod_starts, args.hexapod_generated)
     for cli in (

@@ -16,7 +16,7 @@ compiled kernel, or the hexapod's PyBullet workers) and measures, per episode
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -81,6 +81,11 @@ class SuiteResult:
     perturbation: PerturbationSet
     applied: tuple[str, ...]  # the set's quantities this robot's simulation applied
     not_applicable: tuple[str, ...]  # the set's quantities it cannot model
+    # Per episode, (cycles,) the primitive run each cycle and (cycles, n_outputs) the
+    # network's outputs (empty when the task records none): what an analysis of the
+    # choices needs (bench/adaptation_heldout.py replays the adapting model from them).
+    choices: list[np.ndarray] = field(default_factory=list)
+    outputs: list[np.ndarray] = field(default_factory=list)
 
     def per_maze(self) -> list[dict]:
         """Figures per maze, mazes in suite order (see :func:`summarise`)."""
@@ -210,7 +215,7 @@ def evaluate_suite(
     fields = [solve(m, cell, margin, snap) for m in task.mazes]
     window = round(min(STALL_TIME, task.settings.episode_time) / task.dt)
     step = progress_step(task.footprint_radius)
-    episodes, paths = [], []
+    episodes, paths, choices, outputs = [], [], [], []
     for e, row in enumerate(starts):
         k = int(row[0])
         maze, n = task.mazes[k], int(result.cycles[e])
@@ -236,4 +241,7 @@ def evaluate_suite(
             )
         )
         paths.append(pose)
-    return SuiteResult(episodes, paths, perturbation, applied, missing)
+        if result.choice is not None and result.outputs is not None:
+            choices.append(result.choice[e, :n])
+            outputs.append(result.outputs[e, :n])
+    return SuiteResult(episodes, paths, perturbation, applied, missing, choices, outputs)

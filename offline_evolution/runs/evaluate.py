@@ -86,8 +86,28 @@ def evaluate_run(run: EvaluateRun, reporters: Sequence[Reporter] = ()) -> Evalua
         return _evaluate(run, Reporters(reporters))
 
 
-def _evaluate(run: EvaluateRun, report: Reporters) -> EvaluateOutcome:
-    """:func:`evaluate_run` once its outputs are checked and locked."""
+@dataclass(frozen=True)
+class SuiteRuns:
+    """What :func:`run_suites` ran: the controller, the suite and its episodes."""
+
+    arbitrator: ArbitratorFile
+    path: Path  # of the arbitrator file
+    repertoire: object  # the EvoRBC controller's Repertoire (None: standard)
+    repertoire_path: object  # as the report records it
+    base: object  # the arbitrator's task settings (episode time)
+    task: object  # the suite's maze task (closed)
+    perturbation: object  # the PerturbationSet
+    suite: object  # SuiteResult without adaptation
+    adapted: object  # SuiteResult with adaptation (``run.adapt``), or None
+    settings: object  # the AdaptationSettings with ``run.adapt``, or None
+
+
+def run_suites(run: EvaluateRun, report: Reporters) -> SuiteRuns:
+    """The suite's episodes, and with ``run.adapt`` the same ones adapting (no outputs).
+
+    Raises:
+        UserError, ConfigError, RepertoireError, ArbitratorError: as :func:`evaluate_run`.
+    """
     from offline_evolution.maze_task.evaluation import evaluate_suite
     from offline_evolution.maze_task.perturbation import load_perturbations
 
@@ -108,11 +128,31 @@ def _evaluate(run: EvaluateRun, report: Reporters) -> EvaluateOutcome:
             )
         except ValueError as e:
             raise UserError(f"--perturb {run.perturb}: {e}") from None
-        adapted = None
+        adapted = settings = None
         if adaptation is not None:
-            adapted = _adapted_suite(run, arb, task, controller, perturbation, *adaptation)
+            settings, arrays = adaptation
+            task.adapt(arrays)
+            try:
+                adapted = evaluate_suite(
+                    task, arb.network, controller, run.starts, run.seed, perturbation
+                )
+            finally:
+                task.adapt(None)
     finally:
         task.close()
+    return SuiteRuns(
+        arb, arb_path, repertoire, rep_path, base, task, perturbation, suite, adapted, settings
+    )
+
+
+def _evaluate(run: EvaluateRun, report: Reporters) -> EvaluateOutcome:
+    """:func:`evaluate_run` once its outputs are checked and locked."""
+    runs = run_suites(run, report)
+    arb, arb_path, rep_path, base = runs.arbitrator, runs.path, runs.repertoire_path, runs.base
+    task, perturbation, suite = runs.task, runs.perturbation, runs.suite
+    adapted = None
+    if runs.adapted is not None:
+        adapted = _adapted_section(run, runs.settings, runs.adapted, perturbation)
     if suite.not_applicable:
         report.warning(
             f"--perturb {perturbation.name}: {arb.robot}'s simulation cannot model "
@@ -174,21 +214,14 @@ def _adaptation(run: EvaluateRun, arb, task, repertoire):
     return settings, adapting(repertoire, settings, task.dt, expected)
 
 
-def _adapted_suite(run, arb, task, controller, perturbation, settings, arrays) -> dict:
-    """The same episodes (starts, worlds) with the controller adapting, each from the prior.
+def _adapted_section(run, settings, suite, perturbation) -> dict:
+    """The report's ``adaptation`` section of an adapted suite.
 
-    Returns the report's ``adaptation`` section: the settings, the figures as without, and
-    each episode as without (in the same order, so that its reach compares one to one).
+    The settings, the figures as without, and each episode as without (in the same order,
+    so that its reach compares one to one).
     """
     from dataclasses import asdict
 
-    from offline_evolution.maze_task.evaluation import evaluate_suite
-
-    task.adapt(arrays)
-    try:
-        suite = evaluate_suite(task, arb.network, controller, run.starts, run.seed, perturbation)
-    finally:
-        task.adapt(None)
     return {
         "settings": asdict(settings),
         "expected": run.adapt_expected,
