@@ -384,3 +384,16 @@ def test_a_maze_the_robot_does_not_fit_is_scaled_as_offline_and_not_blamed_on_st
     assert code == 2 and len(err) == 1
     assert err[0].startswith("evorbc-sim: error: robot hexapod does not fit maze zigzag: ")
     assert "--start" not in err[0] and err[0].endswith("its maze is hexapod")
+
+
+def test_adaptation_turns_on_the_arbitrator_s_and_the_bridge_waits_for_its_odom():
+    """evorbc-sim --adapt, launch adaptation:=true: the arbitrator adapts, and the bridge
+    waits for both odom subscribers (radar, arbitrator) so that lockstep stays exact."""
+    plain, adapting = sim_graph(), sim_graph(adaptation=True)
+    arbitrator = adapting.node("arbitrator").parameters
+    assert arbitrator["adaptation"] is True
+    assert "adaptation" not in plain.node("arbitrator").parameters
+    bridge = adapting.node("sim_bridge").parameters
+    assert bridge["wait_for_subscribers"] == ["scan", "odom", "odom"]
+    assert "wait_for_subscribers" not in plain.node("sim_bridge").parameters
+    assert graph_from_arguments({"adaptation": "true"}) == adapting

@@ -92,6 +92,12 @@ def parse_args(argv=None) -> argparse.Namespace:
         "realistic, 4ws-stuck-steering, hexapod-leg-lost, ...; docs/perturbations.md); one "
         "world drawn from --seed",
     )
+    p.add_argument(
+        "--adapt",
+        action="store_true",
+        help="the arbitrator corrects its primitives' outcomes from odometry while driving "
+        "(its adaptation parameter; docs/adaptation.md), as evaluate --adapt does offline",
+    )
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--plot", default="", help="trajectory picture (default: <maze>-run.png)")
     p.add_argument("--result", default="", help="also keep the result as JSON here")
@@ -196,6 +202,7 @@ def start_graph(
         result_file=result_file,
         bag=args.bag,
         maze_scale=args.maze_scale,
+        adaptation=args.adapt,
     )
     procs = [graph.start(node, spec.namespace) for node in spec.nodes]
     return procs[-1]  # the bridge, started last: it waits for the others anyway

@@ -85,6 +85,12 @@ ARGUMENTS = (
         "config/perturbations/ or a YAML file (docs/perturbations.md)",
     ),
     Argument(
+        "adaptation",
+        "false",
+        "true: the arbitrator corrects its primitives' outcomes from odometry while driving "
+        "(docs/adaptation.md), as evaluate --adapt does offline",
+    ),
+    Argument(
         "namespace",
         "",
         "namespace of every node and topic (e.g. robot1); /clock stays global",
@@ -249,13 +255,18 @@ def laser_range(arbitrator: str) -> dict:
     and the lockstep run would leave the offline one (docs/design.md section 9).
     """
     reach = rangefinder_reach(arbitrator)
-    default = next(p.default for p in PARAMETERS if p.name == "laser_range")
+    default = bridge_default("laser_range")
     return {"laser_range": reach} if reach is not None and reach > default else {}
 
 
 def default_maze(robot: str) -> str:
     """The maze a robot runs in when none is named (its registration's: obstacle for 4WS)."""
     return registry.lookup(robot).maze
+
+
+def bridge_default(name: str):
+    """The simulation bridge's default value of parameter ``name``."""
+    return next(p.default for p in PARAMETERS if p.name == name)
 
 
 def sim_graph(
@@ -274,6 +285,7 @@ def sim_graph(
     paper: bool = False,
     bag: str = "",
     maze_scale: float = 0.0,
+    adaptation: bool = False,
 ) -> SimGraph:
     """The graph that runs ``arbitrator`` (default: the one shipped for ``robot``) in a maze.
 
@@ -283,6 +295,10 @@ def sim_graph(
     ``maze_scale``: the factor the bridge scales the maze by (>= 1); 0: the one the
     controller's task recorded for this maze, else the bridge fits the maze to the robot as
     offline runs do (docs/design.md section 21).
+    ``adaptation``: the arbitrator's ``adaptation`` parameter on; the bridge then waits for
+    two subscribers of ``odom`` (the radar node's and the arbitrator's), so that in lockstep
+    the arbitrator sees the first pose and the episode is the offline one
+    (docs/design/adaptation.md).
 
     Raises:
         ConfigError: an unknown robot or mode, or ``paper`` with ``arbitrator`` (one line
@@ -321,6 +337,9 @@ def sim_graph(
         },
     )
     ready = {"wait_for_ready": ["recorder/ready"]} if bag else {}
+    adapting = {"adaptation": True} if adaptation else {}
+    if adaptation:  # a topic named twice needs two subscribers
+        ready["wait_for_subscribers"] = [*bridge_default("wait_for_subscribers"), "odom"]
     return SimGraph(
         (
             *([recorder] if bag else []),
@@ -333,6 +352,7 @@ def sim_graph(
                 repertoire=repertoire,
                 robot=robot,
                 record_file=record_file,
+                **adapting,
             ),
             evorbc("primitive_executor", managed=True, robot=robot, lockstep=mode == "lockstep"),
             NodeSpec(
@@ -381,7 +401,7 @@ def graph_from_arguments(values: dict[str, str]) -> SimGraph:
         ConfigError: one line naming the argument and what it takes.
     """
     given = {a.name: values.get(a.name, a.default) for a in ARGUMENTS}
-    gui, paper = (_boolean(given, name) for name in ("gui", "paper"))
+    gui, paper, adaptation = (_boolean(given, n) for n in ("gui", "paper", "adaptation"))
     try:
         seed = int(given["seed"])
     except ValueError:
@@ -402,6 +422,7 @@ def graph_from_arguments(values: dict[str, str]) -> SimGraph:
             namespace=given["namespace"],
             paper=paper,
             bag=given["bag"],
+            adaptation=adaptation,
         )
     except ConfigError as e:
         raise ConfigError(f"argument {e}") from None
