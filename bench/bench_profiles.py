@@ -25,6 +25,8 @@ import sys
 import time
 from pathlib import Path
 
+from offline_evolution.recipes.profiles import is_urdf
+
 EVOLVE = [sys.executable, "-P", "-m", "offline_evolution.cli"]
 
 
@@ -106,10 +108,8 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_evaluate:
         arbitrator = next(args.out.glob("*.arbitrator.json"))
         # Where the robot is declared: made from a URDF, or the robot file's folder.
-        folder = (
-            args.out / "robots" if args.source.endswith(".urdf") or ":" in args.source else None
-        )
-        robots = str(folder or Path(args.source).resolve().parent)
+        urdf = is_urdf(args.source)
+        robots = str(args.out / "robots" if urdf else Path(args.source).resolve().parent)
         own = ["--starts", str(args.starts), "--mazes", "paper"]
         held = ["--generated", str(args.held_out), "--starts", str(args.held_out_starts)]
         figures["own_maze"] = reach(arbitrator, robots, own)
