@@ -2,13 +2,24 @@
 
     score = upright x switching x accuracy x mobility - cost
 
-* ``upright``, ``switching``: shares in [0, 1] (sim_bridge/legged/gait_measures.py);
+* ``upright``: the share of random primitives upright after T (sim_bridge/legged/
+  gait_measures.py);
+* ``switching``: the probability that a maze episode (the robot's episode time, 30 s)
+  ends without a fall while random steady primitives are chained every 0.1 s in a room
+  of the maze's walls (gait_measures.py; walls and episode length felled the quick
+  profile's A1, docs/your-robot.md);
 * ``accuracy = min(1, CELL / endpoint error)``: 1 while the design's physics ends
   primitives within one archive cell (8 cm) of the 1 kHz reference, falling as 1 / error
   beyond: a repertoire whose cells are wrong misleads the arbitrator;
-* ``mobility = min(1, reach / (REACH_SHARE x speed_bound x T))``: the upright primitives'
-  median reach against a quarter of the archive's half-width; without it a robot that
-  stands still (zero ranges) would score best;
+* ``mobility = min(1, SPREAD x speed / required speed)``: ``speed`` (m/s) is the 90th
+  percentile of the upright random primitives' distance over T; the repertoire's search
+  (MAP-Elites) finds faster gaits than random ones, and ``SPREAD`` = 2 is the lowest ratio
+  measured between a quick repertoire's fastest forward primitive and that percentile
+  (the Laikago's 0.185 m/s against 0.092 m/s; the A1's 0.75 against 0.20). The required
+  speed (m/s) is the longest path of the robot's generated mazes over 2/3 of its episode
+  time (maze_needs.py: the generator's own allowance; the A1: 8.67 m / 20 s = 0.43 m/s).
+  Without it a robot that stands still (zero ranges, a soft servo) would score best, and
+  a slow upright one (the quick profile's Laikago, docs/your-robot.md) did;
 * ``cost = COST_PER_DOUBLING x log2(rate / 50 Hz)``: the CPU time of an evaluation is
   proportional to the physics rate (docs/a1.md: 25, 49, 129 ms at 100, 200, 500 Hz); each
   doubling halves the evaluations a budget buys, and costs as much as 5 % of the usable
@@ -20,34 +31,35 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
-from sim_bridge.legged.gait_measures import DesignMeasures, T
+from sim_bridge.legged.gait_measures import DesignMeasures
 
 CELL = 0.08  # m, an archive cell of the A1 and hexapod (docs/a1.md, "Physics rate")
-REACH_SHARE = 0.25
+SPREAD = 2.0  # a repertoire's fastest forward speed over random gaits' 90th percentile
 COST_PER_DOUBLING = 0.05
 BASE_RATE = 50.0  # Hz, the cheapest rate tried: no cost
 
 FORMULA = (
-    "upright x switching x min(1, 0.08 m / endpoint_error) "
-    "x min(1, reach / (0.25 x speed_bound x 2 s)) - 0.05 x log2(rate_hz / 50 Hz)"
+    "upright x survival of a maze episode switching among walls x min(1, 0.08 m / "
+    "endpoint_error) x min(1, 2 x speed_p90 / (maze path / (2/3 x episode time))) "
+    "- 0.05 x log2(rate_hz / 50 Hz)"
 )
 
 
-def terms(measures: DesignMeasures, rate: float, speed_bound: float) -> dict[str, float]:
-    """The objective's factors and cost (dimensionless)."""
+def terms(measures: DesignMeasures, rate: float, required_speed: float) -> dict[str, float]:
+    """The objective's factors and cost (dimensionless); ``required_speed`` in m/s."""
     error = measures.endpoint_error
     return {
         "upright": measures.upright,
         "switching": measures.switching,
         "accuracy": min(1.0, CELL / error) if error > 0 else 1.0,
-        "mobility": min(1.0, measures.reach / (REACH_SHARE * speed_bound * T)),
+        "mobility": min(1.0, SPREAD * measures.speed / required_speed),
         "cost": COST_PER_DOUBLING * math.log2(rate / BASE_RATE),
     }
 
 
-def score(measures: DesignMeasures, rate: float, speed_bound: float) -> float:
-    """The objective (higher is better; at most 1)."""
-    t = terms(measures, rate, speed_bound)
+def score(measures: DesignMeasures, rate: float, required_speed: float) -> float:
+    """The objective (higher is better; at most 1); ``required_speed`` in m/s."""
+    t = terms(measures, rate, required_speed)
     return t["upright"] * t["switching"] * t["accuracy"] * t["mobility"] - t["cost"]
 
 
@@ -57,7 +69,7 @@ class Budget:
 
     gaits: int  # random primitives per design (T = 2 s from rest)
     accuracy: int  # of them, compared with the 1 kHz reference
-    episodes: int  # switching episodes per design
+    episodes: int  # switching episodes per design, in a walled room
     episode_time: float  # s per switching episode
     sobol: int  # designs of the space-filling stage (a power of 2)
     refine: int  # designs of the local refinement
@@ -68,12 +80,14 @@ class Budget:
         return asdict(self)
 
 
-#: ``--budget``: quick fits about 10 min on one core for the A1 (docs/legged.md).
+#: ``--budget``: quick fits about 10 min on one core for the A1 (docs/legged.md). The
+#: switching episodes simulate as much as before walls came (quick 12 x 5 s, full 20 x
+#: 10 s), in fewer, longer episodes: pressing against a wall takes time to fell a robot.
 BUDGETS = {
     "quick": Budget(
-        gaits=40, accuracy=8, episodes=12, episode_time=5.0, sobol=32, refine=32, validate=3
+        gaits=40, accuracy=8, episodes=6, episode_time=10.0, sobol=32, refine=32, validate=3
     ),
     "full": Budget(
-        gaits=60, accuracy=12, episodes=20, episode_time=10.0, sobol=64, refine=64, validate=5
+        gaits=60, accuracy=12, episodes=10, episode_time=20.0, sobol=64, refine=64, validate=5
     ),
 }

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.config import load_yaml_mapping
+from offline_evolution.gait_design.maze_needs import MazeNeeds, maze_needs
 from offline_evolution.gait_design.objective import FORMULA, Budget
 from offline_evolution.gait_design.search import DesignSearch, SearchResult
 from offline_evolution.gait_design.space import DesignSpace
@@ -17,7 +18,9 @@ def _rounded(measures: dict) -> dict:
     return {k: (round(v, 4) if isinstance(v, float) else v) for k, v in measures.items()}
 
 
-def record(result: SearchResult, space: DesignSpace, seed: int, budget: str) -> dict:
+def record(
+    result: SearchResult, space: DesignSpace, seed: int, budget: str, needs: MazeNeeds
+) -> dict:
     """The ``design_search:`` record of the written settings file."""
     old = space.current()
     return {
@@ -25,6 +28,7 @@ def record(result: SearchResult, space: DesignSpace, seed: int, budget: str) -> 
         "seed": seed,
         "budget": budget,
         "objective": FORMULA,
+        "maze": _rounded(needs.as_dict()),
         "score": round(result.chosen_validation.score, 4),
         "measures": _rounded(result.chosen_validation.measures.as_dict()),
         "search_score": round(result.chosen_search.score, 4),
@@ -91,20 +95,25 @@ def design_gait(
     text, data = legged_settings(settings)
     space = DesignSpace.of(data, settings)
     checkpoint = checkpoint or out.with_name(out.name + ".checkpoint.json")
+    needs = maze_needs(space.settings)
     progress(
         f"{space.settings.name}: searching servo gain 2-45/s, gait frequency "
         f"{0.4 * space.settings.gait.frequency:g}-{2 * space.settings.gait.frequency:g} Hz, "
         f"physics {', '.join(f'{r:g}' for r in space.rates)} Hz, ranges "
         + ", ".join(f"{g} x0.2-{m:g}" for g, m in zip(space.groups, space.scale_max, strict=True))
-        + f"; {budget_name} budget, seed {seed}"
+        + f"; {budget_name} budget, seed {seed}; maze {needs.maze}: {needs.path:.2f} m of path "
+        f"in {needs.episode_time:g} s needs {needs.required_speed:.2f} m/s, switching in a "
+        f"{needs.room:.2f} m room"
     )
-    search = DesignSearch(space, text, budget, seed, checkpoint, progress, should_stop, every)
+    search = DesignSearch(
+        space, text, budget, seed, needs, checkpoint, progress, should_stop, every
+    )
     search.load(restart)
     result = search.run()
     from offline_evolution.gait_design.settings_file import design_text
 
-    new = design_text(text, space, result.chosen, record(result, space, seed, budget_name),
-                      settings, out)  # fmt: skip
+    new = design_text(text, space, result.chosen,
+                      record(result, space, seed, budget_name, needs), settings, out)  # fmt: skip
     atomic_write_text(out, new)
     checkpoint.unlink(missing_ok=True)
     kept = "kept the current design" if result.chosen == space.current() else "chose a new design"

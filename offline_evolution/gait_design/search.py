@@ -36,12 +36,13 @@ from offline_evolution.checkpoint import (
     load_json_checkpoint,
     settings_mismatch,
 )
+from offline_evolution.gait_design.maze_needs import MazeNeeds
 from offline_evolution.gait_design.objective import Budget, score
 from offline_evolution.gait_design.space import DesignSpace, key
 from sim_bridge.legged.gait_measures import DesignMeasures, measure_design, reference_rows
 
 KIND = "design-gait"
-VERSION = 1
+VERSION = 2  # 2: switching among walls over a maze episode, speed against the maze
 
 
 @dataclass(frozen=True)
@@ -85,6 +86,7 @@ class DesignSearch:
         space: the design space of the settings file.
         text: the settings file's text (the checkpoint records its digest).
         budget, seed: what to measure and how many designs; the seed of everything random.
+        needs: what the robot's mazes ask (its room, episode time, required speed).
         checkpoint: the JSON checkpoint file.
         progress: called with one line per design scored.
         should_stop: polled between designs; True saves the checkpoint and stops with
@@ -99,12 +101,14 @@ class DesignSearch:
         text: str,
         budget: Budget,
         seed: int,
+        needs: MazeNeeds,
         checkpoint: Path,
         progress: Callable[[str], None] = lambda line: None,
         should_stop: Callable[[], bool] = lambda: False,
         every: int = 1,
     ) -> None:
-        self.space, self.budget, self.seed = space, budget, seed
+        self.space, self.budget, self.seed, self.needs = space, budget, seed, needs
+        self.room = needs.room_boxes()
         self.checkpoint = Path(checkpoint)
         self.progress, self.should_stop, self.every = progress, should_stop, every
         self.header = {
@@ -113,6 +117,7 @@ class DesignSearch:
             "settings_sha256": hashlib.sha256(text.encode()).hexdigest(),
             "seed": seed,
             "budget": budget.as_dict(),
+            "maze": needs.as_dict(),
         }
         n = space.settings.gait.n_parameters
         self.genes = {
@@ -197,8 +202,10 @@ class DesignSearch:
                 b.episode_time,
                 self.seed + (1 if which == "validate" else 0),
                 self._reference(values, which),
+                self.room,
+                self.needs.episode_time,
             )
-            s = score(measures, values["rate_hz"], design.speed_bound)
+            s = score(measures, values["rate_hz"], self.needs.required_speed)
             wall, cpu = time.perf_counter() - start, time.process_time() - cpu
             result = Scored(stage, values, measures, s, wall, cpu)
         self.done.append(result)
@@ -217,8 +224,10 @@ class DesignSearch:
         return (
             f"design {len(self.done)} ({r.stage}): gain {v['gain']:g}/s, "
             f"{v['frequency_hz']:g} Hz gait, {v['rate_hz']:g} Hz physics, ranges {scales}: "
-            f"upright {m.upright:.0%}, switching {m.switching:.0%}, error {error}, reach "
-            f"{m.reach:.2f} m, {m.ms_per_evaluation:.0f} ms/eval -> score {r.score:.3f} [{when}]"
+            f"upright {m.upright:.0%}, switching {m.switching:.0%} ({m.falls} falls in "
+            f"{m.exposure:.0f} s), error {error}, reach {m.reach:.2f} m, speed "
+            f"{m.speed:.2f} m/s, {m.ms_per_evaluation:.0f} ms/eval -> score {r.score:.3f} "
+            f"[{when}]"
         )
 
     # -- the search ------------------------------------------------------------------

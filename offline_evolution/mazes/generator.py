@@ -144,11 +144,28 @@ def spec_for_robot(name: str) -> MazeSpec:
             is not solvable with its footprint at any scale (nothing to size mazes from).
     """
     from evorbc_ros.robots.registry import lookup
-    from sim_bridge.maze_fit import fitted_maze
 
     robot = lookup(name)
-    own = load_named_maze(robot.maze)
-    r = robot.footprint_radius
+    return sized_spec(name, robot.maze, robot.footprint_radius, robot.max_speed, robot.episode_time)
+
+
+def sized_spec(
+    name: str, maze_name: str, footprint_radius: float, max_speed: float, episode_time: float
+) -> MazeSpec:
+    """:func:`spec_for_robot` of a robot given by its fields, registered or not.
+
+    Args:
+        name: the robot's name (for messages and the spec).
+        maze_name: its default maze (a shipped maze's name or a maze file).
+        footprint_radius: m. max_speed: m/s. episode_time: s.
+
+    Raises:
+        ConfigError: as :func:`spec_for_robot`.
+    """
+    from sim_bridge.maze_fit import fitted_maze
+
+    own = load_named_maze(maze_name)
+    r = footprint_radius
     try:
         maze, scale, warning = fitted_maze(own, r, name)
     except ValueError as e:
@@ -163,13 +180,13 @@ def spec_for_robot(name: str) -> MazeSpec:
     path = field_.distance_from(*maze.start_pose[:2])
     if not math.isfinite(path):
         raise ConfigError(
-            f"robot {name}: its maze {robot.maze} has no path with {margin:.3f} m clearance; "
+            f"robot {name}: its maze {maze_name} has no path with {margin:.3f} m clearance; "
             "cannot size generated mazes from it"
         )
     gap = narrowest_gap(maze, cell)
     height = round(inner_h, 3)
     width = round((x1 - x0) - 2 * t, 3)
-    reach = 2.0 / 3.0 * robot.max_speed * robot.episode_time  # m driven in 2/3 of T
+    reach = 2.0 / 3.0 * max_speed * episode_time  # m driven in 2/3 of T
     if scale > 1.0 and 1.1 * path > reach:
         # A scaled-up maze the robot cannot cross in time: shorter by the same ratio.
         width = round(width * reach / (1.1 * path), 3)

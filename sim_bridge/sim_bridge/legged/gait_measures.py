@@ -5,13 +5,22 @@ used by hand):
 
 * **upright**: the share of random primitives (genes uniform in [-1, 1]) that never tilt
   past the discard tilt in T = 2 s from rest, the repertoire's test (eq. 6);
-* **switching**: the share of episodes that do not fall over (tilt past the fallen tilt)
-  while the steady primitives (never past :data:`POOL_TILT`) are chained at random every
-  control cycle, 0.1 s, as an arbitrator may chain them;
+* **switching**: the probability that a maze episode (``maze_time`` s) ends without a fall
+  (tilt past the fallen tilt) while the steady primitives (never past :data:`POOL_TILT`)
+  are chained at random every control cycle, 0.1 s, as an arbitrator may chain them.
+  Every other episode runs in free space from the rest pose; the others in a walled room
+  (``walls``: the maze's walls) from its centre, facing a random heading, chaining only
+  the steady primitives that carry the body forward, so that they press against a wall
+  as an arbitrator steering for a target beyond one does. The falls per second of
+  simulated time, ``falls / exposure``, give the survival over a maze episode,
+  ``exp(-falls x maze_time / exposure)`` (a constant fall rate: longer episodes fall more
+  often, which the share of short episodes did not see);
 * **endpoint error**: the median distance (m) between where a primitive ends after T at
   the design's physics rate and at a fine reference (1 kHz, 50 solver iterations), over
   the primitives the reference keeps upright;
 * **reach**: the median distance (m) from the start after T of the upright primitives;
+* **speed**: the :data:`SPEED_PERCENTILE` th percentile of the upright primitives'
+  distance from the start after T, over T (m/s): what the design's fast gaits make;
 * **cost**: CPU milliseconds of one process per T-second evaluation.
 
 Units: m, s, rad (deg where a name says so).
@@ -40,6 +49,8 @@ REFERENCE = (1000.0, 50)
 #: rad: primitives chained when switching never tilted past this in their T; circular+tilt
 #: quality keeps such steady primitives in a repertoire (docs/a1.md, "Gait design").
 POOL_TILT = math.radians(20.0)
+#: The percentile of the upright primitives' speeds that :attr:`DesignMeasures.speed` is.
+SPEED_PERCENTILE = 90.0
 
 
 def with_physics(
@@ -60,24 +71,41 @@ def endpoint_errors(rows: np.ndarray, ref: np.ndarray, discard: float) -> np.nda
     return np.hypot(rows[kept, X] - ref[kept, X], rows[kept, Y] - ref[kept, Y])
 
 
-def switching_episode(sim: LeggedSim, table, rows: np.ndarray, hold: int, fallen: float) -> bool:
+def fall_time(
+    sim: LeggedSim,
+    table,
+    rows: np.ndarray,
+    hold: int,
+    fallen: float,
+    pose: tuple[float, float, float] | None = None,
+) -> float:
     """Run primitive ``rows[k // hold]`` of ``table`` in control cycle ``k``, from rest.
 
     Each switch keeps the oscillators' clock (an arbitrator's switch, eq. 10).
 
+    Args:
+        pose: ``(x m, y m, heading rad)`` of the start (world frame); None: the rest pose.
+
     Returns:
-        True if the robot fell over (tilted past ``fallen`` rad).
+        s of simulated time at the end of the cycle the robot fell over in (tilted past
+        ``fallen`` rad), or ``inf`` if it did not.
 
     """
-    sim.reset()
-    steps = sim.physics.steps(sim.settings.control_period)
+    sim.reset(*(pose or ()))
+    period = sim.settings.control_period
+    steps = sim.physics.steps(period)
     for cycle in range(len(rows) * hold):
         row = rows[cycle // hold]
         targets = table.joint_targets(sim.step_times(steps), np.full(steps, row))
         tilt, _ = sim.run(targets, fallen)
         if tilt > fallen:
-            return True
-    return False
+            return (cycle + 1) * period
+    return math.inf
+
+
+def switching_episode(sim: LeggedSim, table, rows: np.ndarray, hold: int, fallen: float) -> bool:
+    """True if the robot fell over in :func:`fall_time`'s episode from the rest pose."""
+    return math.isfinite(fall_time(sim, table, rows, hold, fallen))
 
 
 def joint_limits(settings: LeggedRobotSettings) -> tuple[np.ndarray, np.ndarray]:
@@ -98,11 +126,14 @@ class DesignMeasures:
     """A design's measures on one set of random primitives (see the module docstring)."""
 
     upright: float  # share of primitives upright after T
-    switching: float  # share of switching episodes without a fall
+    switching: float  # probability of a maze episode without a fall
     endpoint_error: float  # m, median against the reference (inf: none to compare)
     reach: float  # m, median distance after T of the upright primitives (0: none)
     ms_per_evaluation: float  # CPU ms per T-second evaluation at the design's rate
     steady: int  # primitives in the switching pool
+    speed: float  # m/s, SPEED_PERCENTILE of the upright primitives' distance / T (0: none)
+    falls: int  # switching episodes that fell
+    exposure: float  # s of switching simulated (each episode to its fall or end)
 
     def as_dict(self) -> dict:
         """Plain data (JSON-safe; an infinite error is written as None)."""
@@ -132,6 +163,8 @@ def measure_design(
     episode_time: float,
     seed: int,
     reference: np.ndarray,
+    walls: np.ndarray | None = None,
+    maze_time: float = 30.0,
 ) -> DesignMeasures:
     """Measure one design on random primitives ``genes``.
 
@@ -143,8 +176,11 @@ def measure_design(
         accuracy: how many of ``genes`` are compared with the reference.
         episodes: switching episodes.
         episode_time: s, each switching episode (a whole number of control periods).
-        seed: of the switching sequences.
+        seed: of the switching sequences and start headings.
         reference: ``(accuracy, 6)`` rows of :func:`reference_rows` for ``genes[:accuracy]``.
+        walls: ``(m, 6)`` wall boxes about the origin the switching episodes start at
+            (facing a random heading); None: free space, from the rest pose.
+        maze_time: s, the maze episode the switching survival is given for.
 
     """
     period, discard = settings.control_period, settings.discard_tilt
@@ -153,24 +189,38 @@ def measure_design(
         full = evaluate_genes(sim, genes[:accuracy], T, period, NO_EARLY_STOP)
         cost = (time.process_time() - start) / max(accuracy, 1)
         rest = evaluate_genes(sim, genes[accuracy:], T, period, discard)
-        rows = np.concatenate([full, rest])
-        upright = rows[:, TILT] <= discard
-        reach = np.hypot(rows[upright, X], rows[upright, Y])
-        steady = np.flatnonzero(rows[:, TILT] <= POOL_TILT)
-        falls = 0
-        if len(steady):
-            table = sim.gait_table(genes[steady])
+    rows = np.concatenate([full, rest])
+    upright = rows[:, TILT] <= discard
+    reach = np.hypot(rows[upright, X], rows[upright, Y])
+    steady = np.flatnonzero(rows[:, TILT] <= POOL_TILT)
+    falls, exposure = 0, 0.0
+    if len(steady) and episodes:
+        # Indices into the pool of the steady primitives that carry the body forward (m,
+        # start frame): chained facing a wall, they press against it, as an arbitrator
+        # steering for a target beyond a wall does.
+        forward = np.flatnonzero(rows[steady, X] > 0.0)
+        with LeggedSim(settings, walls) as room:
+            table = room.gait_table(genes[steady])
             rng = np.random.default_rng(seed)
             cycles = round(episode_time / period)
-            for _ in range(episodes):
-                sequence = rng.integers(len(steady), size=cycles)
-                falls += switching_episode(sim, table, sequence, 1, settings.fallen_tilt)
+            for k in range(episodes):
+                heading = float(rng.uniform(-math.pi, math.pi))
+                walled = walls is not None and k % 2 == 1 and len(forward) > 0
+                pool = forward if walled else np.arange(len(steady))
+                sequence = pool[rng.integers(len(pool), size=cycles)]
+                pose = (0.0, 0.0, heading) if walled else None
+                fell = fall_time(room, table, sequence, 1, settings.fallen_tilt, pose)
+                falls += math.isfinite(fell)
+                exposure += min(fell, cycles * period)
     errors = endpoint_errors(full, reference, discard)
     return DesignMeasures(
         upright=float(upright.mean()),
-        switching=(1.0 - falls / episodes) if len(steady) and episodes else 0.0,
+        switching=math.exp(-falls * maze_time / exposure) if exposure > 0 else 0.0,
         endpoint_error=float(np.median(errors)) if len(errors) else math.inf,
         reach=float(np.median(reach)) if len(reach) else 0.0,
         ms_per_evaluation=1e3 * cost,
         steady=len(steady),
+        speed=float(np.percentile(reach, SPEED_PERCENTILE)) / T if len(reach) else 0.0,
+        falls=falls,
+        exposure=exposure,
     )
