@@ -13,9 +13,10 @@ HELP = (
 )
 DESCRIPTION = (
     "Score designs of a legged robot's gait (servo gain, joint ranges, gait "
-    "frequency, physics rate) by the share of random gaits upright, the share upright "
-    "when gaits switch every 0.1 s, the endpoint error against 1 kHz physics, the reach "
-    "and the cost per evaluation; search them (Sobol, then local refinement, then the "
+    "frequency, physics rate) by the share of random gaits upright, the survival of a "
+    "maze episode when gaits switch every 0.1 s (half the time against the maze's walls), "
+    "the endpoint error against 1 kHz physics, the speed against what the robot's mazes "
+    "need and the cost per evaluation; search them (Sobol, then local refinement, then the "
     "best measured again) and write the chosen one into OUT with a design_search "
     "record (docs/legged.md, 'The gait design search')."
 )
