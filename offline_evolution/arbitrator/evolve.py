@@ -54,6 +54,7 @@ from offline_evolution.arbitrator.selection import (
     final_starts,
     post_evaluate,
     post_evaluation_starts,
+    selection_world,
     validation_rows,
 )
 from offline_evolution.arbitrator.warm_start import network_fingerprint, seed_population
@@ -85,9 +86,10 @@ SELECTION_ONLY = (
     "post_finalists",
     "post_final_samples",
 )
-#: Task keys that only decide which genome is written: the generated validation mazes are
-#: drawn from the post-evaluation's own seed stream, never during evolution.
-TASK_SELECTION_ONLY = ("post_mazes",)
+#: Task keys that only decide which genome is written: the generated validation mazes, and
+#: their worlds (``post_perturb``), are drawn from the post-evaluation's own seed streams,
+#: never during evolution.
+TASK_SELECTION_ONLY = ("post_mazes", "post_perturb")
 #: Fields that say where an input lies, not what it holds: the NEAT file's contents are
 #: checked by ``neat_sha256``, so a run resumes in another checkout or folder.
 LOCATION_ONLY = ("neat_file", "initial_network_file")
@@ -325,6 +327,11 @@ class Evolution:
                 raise
         n_outputs = settings.kind.n_outputs(len(self.task.parameter_specs))
         self.controller = self.task.controller(settings.kind, repertoire, settings.mapping)
+        try:
+            self._adapt_episodes(repertoire)
+        except ConfigError:
+            self.close()
+            raise
         self.config = load_neat_config(
             settings.neat_file, self.task.layout.n_inputs, n_outputs, settings.population
         )
@@ -351,6 +358,37 @@ class Evolution:
         # compared on resume with the files then: a file edited in place is another run; a
         # moved or renamed one is not.
         self._task_by_content = _inputs_by_content(settings.as_dict())["task"]
+
+    def _adapt_episodes(self, repertoire: Repertoire | None) -> None:
+        """``training: adapt: true``: every EvoRBC episode of the run adapts onboard.
+
+        The task's adaptation is :func:`~offline_evolution.maze_task.adapting.task_adapting`'s,
+        what ``evaluate --adapt`` runs; each episode starts from the prior.
+
+        Raises:
+            ConfigError: a standard controller, or a robot whose episodes do not adapt.
+        """
+        training = self.settings.task.get("training") or {}
+        if not training.get("adapt"):
+            return
+        if not self.settings.kind.uses_repertoire:
+            raise ConfigError(
+                "training: adapt: adaptation corrects a repertoire; this run evolves a "
+                "standard controller"
+            )
+        if not hasattr(self.task, "adapt"):
+            raise ConfigError(
+                f"training: adapt: {self.settings.robot}'s episodes do not adapt yet (4WS and "
+                "differential-drive robots do; docs/design/adaptation.md)"
+            )
+        from offline_evolution.maze_task.adapting import task_adapting
+
+        expected = training.get("adapt_expected", "recorded")
+        try:
+            _, arrays = task_adapting(self.task, repertoire, expected)
+        except ValueError as e:
+            raise ConfigError(f"training: adapt_expected {expected}: {e}") from None
+        self.task.adapt(arrays)
 
     def _start_from(self, network: NetworkSpec, threshold: float) -> None:
         """Make the first population from ``network`` (the one the settings fingerprint)."""
@@ -480,6 +518,7 @@ class Evolution:
         """
         candidates = self.hall.candidates()
         starts = post_evaluation_starts(self.task, self.settings.seed, self.settings.post_samples)
+        starts, world = selection_world(self.task, starts, self.settings.seed)
         key = scores_key(candidates, starts)
         if self.post_scores is None or self.post_scores.key != key:
             # none yet, or saved for another hall or other starts (post_samples changed)
@@ -490,9 +529,10 @@ class Evolution:
             if self.final_scores is None:
                 self.final_scores = PostScores("")  # post_evaluate keys it
 
-            def more() -> tuple[np.ndarray, int]:
+            def more() -> tuple[np.ndarray, int, object]:
                 extra = final_starts(self.task, s.seed, s.post_final_samples)
-                return extra, validation_rows(self.task, s.post_final_samples)
+                extra, final_world = selection_world(self.task, extra, s.seed, final=True)
+                return extra, validation_rows(self.task, s.post_final_samples), final_world
 
         post = post_evaluate(
             self.task,
@@ -509,6 +549,7 @@ class Evolution:
             more,
             self.final_scores,
             final_progress,
+            world=world,
         )
         chosen = candidates[post.index]
         return EvolutionResult(

@@ -97,6 +97,7 @@ def score_candidates(
     progress: Callable[[int, int], None] | None = None,
     target_seconds: float = 60.0,
     clock: Callable[[], float] = time.perf_counter,
+    world=None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Score the candidates ``scores`` does not hold yet, a batch at a time.
 
@@ -113,6 +114,7 @@ def score_candidates(
         progress: called as ``(done, total)`` over the episodes this call runs.
         target_seconds: s, batches grow while one takes under half of this.
         clock: s, monotonic (a parameter for tests).
+        world: the starts' worlds (a ``WorldDraw``, one row per start), or None: nominal.
 
     Returns:
         ``(fitness, reached)``, each (candidates, episodes), float64 and bool.
@@ -132,7 +134,10 @@ def score_candidates(
             if reports:
                 task.progress = _shifted(progress, offset, total)
             t0 = clock()
-            result = task.evaluate(batch, controller, starts)
+            if world is None:  # tasks of the caller's own take no world
+                result = task.evaluate(batch, controller, starts)
+            else:
+                result = task.evaluate(batch, controller, starts, world=world)
             seconds = clock() - t0
             scores.fitness.extend(np.asarray(result.fitness, float).reshape(-1, n).tolist())
             scores.reached.extend(np.asarray(result.reached, bool).reshape(-1, n).tolist())

@@ -25,6 +25,10 @@ if TYPE_CHECKING:  # a task pulls in its simulation; the settings loader needs o
 POST_EVALUATION_STREAM = 2**31 - 1
 #: Seed stream of the finalists' further starts (``post_finalists``), apart from both.
 FINAL_STREAM = 2**31 - 2
+#: Seed streams of the post-evaluation's worlds (``training: post_perturb``), first round
+#: and finalists', apart from the starts' so that perturbing leaves the starts drawn alike.
+POST_WORLD_STREAM = 2**31 - 3
+FINAL_WORLD_STREAM = 2**31 - 4
 
 #: How the post-evaluation picks the controller to write:
 #: ``mean``: the highest mean fitness over all post-evaluation episodes;
@@ -203,6 +207,24 @@ def _draws(task: ArbitratorTask, rng: np.random.Generator, samples: int) -> np.n
     return np.concatenate(rows) if rows else np.zeros((0, 4))
 
 
+def selection_world(task: ArbitratorTask, starts: np.ndarray, seed: int, final: bool = False):
+    """``(starts, world)`` of the post-evaluation: in worlds of the training's ``perturb``.
+
+    With ``training: post_perturb: true`` each of ``starts`` (rows ``(maze, x, y,
+    heading)`` of the task's current mazes, as :func:`post_evaluation_starts` or, with
+    ``final``, :func:`final_starts` left them) gets its own world of the training's set,
+    drawn from the run's seed on a stream of its own, its start errors applied; the
+    world is a :class:`~offline_evolution.maze_task.perturbation.WorldDraw`. Otherwise
+    ``(starts, None)``: the nominal world, as every run before the setting.
+    """
+    training = getattr(task, "training", None)
+    if training is None or not training.settings.post_perturb or not training.perturbed:
+        return starts, None
+    stream = FINAL_WORLD_STREAM if final else POST_WORLD_STREAM
+    world = training.perturbation.draw(np.random.default_rng([seed, stream]), len(starts))
+    return world.shift_starts(starts, task.mazes, task.footprint_radius), world
+
+
 def validation_rows(task: ArbitratorTask, samples: int) -> int:
     """How many of :func:`post_evaluation_starts`' rows lie in generated validation mazes."""
     training = getattr(task, "training", None)
@@ -226,6 +248,7 @@ def post_evaluate(
     more_starts: Callable[[], tuple[np.ndarray, int]] | None = None,
     final_scores: PostScores | None = None,
     final_progress: Callable[[int, int], None] | None = None,
+    world=None,
 ) -> PostEvaluation:
     """Score every network on ``starts`` and pick one by ``rule`` (see :data:`RULES`).
 
@@ -248,12 +271,15 @@ def post_evaluate(
     round's saved rows (its key is set here), ``final_progress`` reports its episodes (by
     default ``progress``), and ``after_batch`` is called with a third argument,
     ``"finalists"``, during it.
+
+    ``world``: the worlds of ``starts`` (:func:`selection_world`), or None for the nominal
+    world; ``more_starts()`` may give the finalists' worlds as a third item.
     """
     if rule not in RULES:
         raise ValueError(f"post-evaluation rule must be one of {', '.join(RULES)}, got {rule!r}")
     scores = PostScores("") if scores is None else scores
     fitness_all, reached_all = score_candidates(
-        task, controller, networks, starts, scores, after_batch, progress
+        task, controller, networks, starts, scores, after_batch, progress, world=world
     )
     if nominal_rows is None:
         nominal_rows = len(task.mazes)
@@ -262,7 +288,7 @@ def post_evaluate(
     k, rows = int(order[0]), np.arange(len(networks))
     top = np.sort(order[: min(finalists, len(networks))])
     if len(top) and more_starts is not None:
-        extra, extra_validation = more_starts()
+        extra, extra_validation, *final_world = more_starts()
         final_scores = PostScores("") if final_scores is None else final_scores
         key = final_key(scores.key, top, extra)
         if final_scores.key != key:  # rows of other finalists or other starts: run again
@@ -276,6 +302,7 @@ def post_evaluate(
             final_scores,
             stage,
             progress if final_progress is None else final_progress,
+            world=final_world[0] if final_world else None,
         )
         fitness_all = _join(fitness_all[top], f2, validation, extra_validation)
         reached_all = _join(reached_all[top], r2, validation, extra_validation)

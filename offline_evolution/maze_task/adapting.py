@@ -23,9 +23,10 @@ from evorbc_ros.adaptation.model import OutcomeModel
 from evorbc_ros.adaptation.online import settings_arrays
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.maze_task.kernel import Adapting
+from offline_evolution.maze_task.training import ADAPT_EXPECTED
 
 #: What an observation is compared with.
-EXPECTED = ("recorded", "settled")
+EXPECTED = ADAPT_EXPECTED
 
 
 def expected_outcomes(repertoire: Repertoire, robot, expected: str) -> np.ndarray | None:
@@ -73,3 +74,21 @@ def adapting(
         int(settings.capacity),
         float(dt),
     )
+
+
+def task_adapting(task, repertoire: Repertoire, expected: str) -> tuple[AdaptationSettings, Adapting]:
+    """The default :class:`AdaptationSettings` and the kernel's adaptation for ``task``.
+
+    What ``evaluate --adapt`` and a training run with ``training: adapt: true`` give
+    :meth:`~offline_evolution.maze_task.task.MazeTask.adapt`: one code for both.
+
+    Args:
+        task: a kinematic maze task (its ``robot`` and control period ``dt``, s).
+        expected: ``recorded`` or ``settled`` (:func:`expected_outcomes`).
+
+    Raises:
+        ValueError: ``settled`` for a robot that is not 4WS, or an unknown ``expected``.
+    """
+    settings = AdaptationSettings()
+    outcomes = expected_outcomes(repertoire, task.robot, expected)
+    return settings, adapting(repertoire, settings, task.dt, outcomes)

@@ -24,7 +24,16 @@ A maze task whose settings hold a ``training`` mapping trains on the generator's
   ends and baffles turn into traps; the path length does not;
 * ``serpentine: F`` makes a share F of the training mazes' obstacles serpentines (the
   generator's narrow winding shafts, as in the paper's ``corridors``; the standard mix,
-  which the held-out set uses, has none), validation mazes included.
+  which the held-out set uses, has none), validation mazes included;
+* ``adapt: true`` runs every EvoRBC episode of the run (training, nominal watch and
+  post-selection) with the onboard controller's adaptation on, each from the prior, as
+  ``evaluate --adapt`` runs them (docs/design/adaptation.md); ``adapt_expected`` is what an
+  observation is compared with (``recorded`` or ``settled``, as ``--adapt-expected``);
+* ``post_perturb: true`` runs the post-selection's episodes in worlds of ``perturb`` too
+  (each start row its own world, drawn from the post-selection's seed streams), so that a
+  run trained on a damaged robot writes the controller that reaches best on that robot;
+  without it the post-selection runs in the nominal world, as the shipped controllers'
+  did.
 
 Generated mazes are proven solvable by the generator; a task keeps the last
 :data:`CACHE` of them (and their compiled packs, 4WS), so a pool costs its generation once.
@@ -59,6 +68,9 @@ CACHE = 512
 GRID_CACHE = 128
 #: How a missed episode's distance to the target is measured (``training.distance``).
 DISTANCES = ("euclidean", "path")
+#: What an adapting episode compares an observation with (``training.adapt_expected``,
+#: ``evaluate --adapt-expected``; docs/design/adaptation.md).
+ADAPT_EXPECTED = ("recorded", "settled")
 #: Name prefix of training mazes (``train1-000042``): never a held-out maze's ``gen21021-``.
 PREFIX = "train"
 
@@ -88,6 +100,15 @@ class TrainingSettings:
         minimum=0.0,
         maximum=MAX_SERPENTINE,
     )
+    adapt: bool = setting(
+        False, doc="EvoRBC episodes adapt onboard (docs/design/adaptation.md), each from the prior"
+    )
+    adapt_expected: str = setting(
+        "recorded", doc="what an adapting episode compares observations with: recorded or settled"
+    )
+    post_perturb: bool = setting(
+        False, doc="the post-selection's episodes in worlds of perturb too (false: nominal)"
+    )
 
     @classmethod
     def from_dict(cls, values, source: str) -> TrainingSettings:
@@ -115,10 +136,17 @@ class TrainingSettings:
             raise ConfigError(
                 f"{where}: distance {s.distance!r}: expected one of {', '.join(DISTANCES)}"
             )
+        if s.adapt_expected not in ADAPT_EXPECTED:
+            raise ConfigError(
+                f"{where}: adapt_expected {s.adapt_expected!r}: expected one of "
+                f"{', '.join(ADAPT_EXPECTED)}"
+            )
         try:
-            load_perturbations(s.perturb)
+            perturbation = load_perturbations(s.perturb)
         except ConfigError as e:
             raise ConfigError(f"{where}: perturb: {e}") from None
+        if s.post_perturb and perturbation is NONE:
+            raise ConfigError(f"{where}: post_perturb needs a perturb set (perturb is none)")
         return s
 
     def as_dict(self) -> dict:
@@ -135,6 +163,8 @@ class TrainingSettings:
             # setting existed keep their exact settings (a resume compares them).
             **({"distance": self.distance} if self.distance != "euclidean" else {}),
             **({"serpentine": self.serpentine} if self.serpentine else {}),
+            **({"adapt": True, "adapt_expected": self.adapt_expected} if self.adapt else {}),
+            **({"post_perturb": True} if self.post_perturb else {}),
         }
 
 

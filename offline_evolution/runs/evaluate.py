@@ -198,20 +198,17 @@ def _adaptation(run: EvaluateRun, arb, task, repertoire):
     """
     if not run.adapt:
         return None
-    from evorbc_ros.adaptation import AdaptationSettings
-    from offline_evolution.maze_task.adapting import adapting, expected_outcomes
+    from offline_evolution.maze_task.adapting import task_adapting
 
     if not arb.kind.uses_repertoire:
         raise UserError("--adapt: adaptation corrects a repertoire; this is a standard controller")
     if not hasattr(task, "adapt"):
         raise UserError(f"--adapt: {arb.robot}'s episodes do not adapt yet (4WS and "
                         "differential-drive robots do; docs/design/adaptation.md)")  # fmt: skip
-    settings = AdaptationSettings()
     try:
-        expected = expected_outcomes(repertoire, task.robot, run.adapt_expected)
+        return task_adapting(task, repertoire, run.adapt_expected)
     except ValueError as e:
         raise UserError(f"--adapt-expected {run.adapt_expected}: {e}") from None
-    return settings, adapting(repertoire, settings, task.dt, expected)
 
 
 def _adapted_section(run, settings, suite, perturbation) -> dict:
