@@ -216,6 +216,8 @@ def _net():
         ({"perturb": "nosuch"}, "perturb: unknown perturbation set 'nosuch'"),
         ({"pools": 3}, "unknown setting 'pools' \\(did you mean 'pool'\\?\\)"),
         ({"serpentine": 1.0}, "serpentine must be <= 0.9"),
+        ({"adapt": True, "adapt_expected": "nosuch"}, "adapt_expected 'nosuch': expected one"),
+        ({"post_perturb": True}, "post_perturb needs a perturb set"),
     ],
 )
 def test_bad_training_settings_are_one_line_errors(tmp_path, training, message):

@@ -76,7 +76,9 @@ def adapting(
     )
 
 
-def task_adapting(task, repertoire: Repertoire, expected: str) -> tuple[AdaptationSettings, Adapting]:
+def task_adapting(
+    task, repertoire: Repertoire, expected: str
+) -> tuple[AdaptationSettings, Adapting]:
     """The default :class:`AdaptationSettings` and the kernel's adaptation for ``task``.
 
     What ``evaluate --adapt`` and a training run with ``training: adapt: true`` give
