@@ -1,8 +1,8 @@
 """Measure: the upper bound of onboard adaptation, controllers trained on the damaged robot.
 
-Evaluates the controllers config/recipes/4ws-5-damage-bound.yaml writes (each the shipped
-4ws-5 controller continued on a robot of one 4WS damage set, and the control continued
-under ``realistic``) on the held-out generated mazes with the command docs/adaptation.md
+Evaluates the controllers config/recipes/measurements/4ws-5-damage-bound.yaml writes (each
+the shipped 4ws-5 controller continued on a robot of one 4WS damage set, and the control
+continued under ``realistic``) on the held-out generated mazes with the command docs/adaptation.md
 uses for the shipped one: ``evorbc-evolve evaluate --arbitrator FILE --generated 20
 --starts 20 --perturb SET --adapt`` (seed 21021 mazes, never trained on; starts and worlds
 seed 0; ``recorded`` expected, default ``AdaptationSettings``;
@@ -10,7 +10,7 @@ seed 0; ``recorded`` expected, default ``AdaptationSettings``;
 controller runs on its own set; the control on every set, intact (``none``) included.
 Prints the figures and writes them compactly (``--out``, docs/results/adaptation/).
 
-    nice evorbc-evolve recipe config/recipes/4ws-5-damage-bound.yaml --out RUNS
+    nice evorbc-evolve recipe config/recipes/measurements/4ws-5-damage-bound.yaml --out RUNS
     python bench/adaptation_bound.py --runs RUNS [--out docs/results/adaptation/bound.json]
 """
 
