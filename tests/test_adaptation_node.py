@@ -107,7 +107,11 @@ def test_adaptation_expected_settled_reads_the_file_beside_the_repertoire_and_re
     shipped = load_settled(settled_path(node.controller.repertoire_path), rep)
     assert node.controller.adaptation.model.expected.tobytes() == shipped.tobytes()
     assert node.health(0.0).values["adaptation: expected"] == "settled"
-    # Live: back to recorded starts again from the prior against the recorded outcomes.
+    # Live: the value it has changes nothing; back to recorded starts again from the prior
+    # against the recorded outcomes.
+    model = node.controller.adaptation.model
+    assert node.set_parameters([Parameter("adaptation_expected", value="settled")])[0].successful
+    assert node.controller.adaptation.model is model
     assert node.set_parameters([Parameter("adaptation_expected", value="recorded")])[0].successful
     model = node.controller.adaptation.model
     assert model.expected.tobytes() == model.recorded.tobytes() != shipped.tobytes()

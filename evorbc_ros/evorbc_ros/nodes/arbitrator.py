@@ -231,6 +231,8 @@ class ArbitratorNode(ManagedNode):
         if self.controller is None:
             return  # before configure: configure reads it
         if name == "adaptation_expected":
+            if value == self.expected:
+                return  # set to what it is (ros2 param load): keep what was learned
             self.expected = value
             if self.controller.adaptation is not None:
                 self.start_adaptation()
