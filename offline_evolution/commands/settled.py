@@ -5,17 +5,16 @@ hold its command (docs/design/adaptation.md, "What an observation is compared wi
 the robot's motion model can compute that, and the arbitrator node must not import it, so
 this command computes the outcomes offline, exactly as ``evaluate --adapt-expected
 settled`` does, and writes them beside the repertoire for the node to read
-(:mod:`evorbc_ros.adaptation.settled`).
+(:mod:`offline_evolution.runs.settled`, :mod:`evorbc_ros.adaptation.settled`).
 """
 
 from __future__ import annotations
 
 import argparse
 
-from evorbc_ros.adaptation.settled import save_settled, settled_path
-from evorbc_ros.repertoire import Repertoire
-from offline_evolution.runs.errors import UserError
+from evorbc_ros.adaptation.settled import settled_path
 from offline_evolution.runs.outputs import check_distinct
+from offline_evolution.runs.settled import write_settled
 from sim_bridge.cli_support import check_output_file
 
 
@@ -41,20 +40,12 @@ def add_parsers(sub) -> None:
 
 def cmd_settled(args: argparse.Namespace) -> int:
     """Compute and write the settled outcomes of ``args.repertoire``."""
-    from offline_evolution.maze_task.adapting import expected_outcomes
-    from sim_bridge.robots import make_robot
-
-    repertoire = Repertoire.load(args.repertoire)
     if args.out is not None:
         out_option, out = "--out", args.out
     else:
         out_option, out = "the default --out", str(settled_path(args.repertoire))
     check_output_file(out, out_option)
     check_distinct({"REPERTOIRE": args.repertoire, out_option: out})
-    try:
-        outcomes = expected_outcomes(repertoire, make_robot(repertoire.robot), "settled")
-    except ValueError as e:
-        raise UserError(f"{args.repertoire}: {e}") from None
-    save_settled(out, outcomes, repertoire)
+    repertoire = write_settled(args.repertoire, out)
     print(f"{len(repertoire)} settled outcomes of {repertoire.robot} -> {out}")
     return 0
