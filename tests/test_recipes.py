@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from evorbc_ros.adaptation.settled import load_settled
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.config import config_dir
 from evorbc_ros.repertoire import Repertoire
@@ -58,6 +59,9 @@ def test_each_recipe_runs_at_the_small_budget(recipe, tmp_path, capsys):
             assert arb.evolution["generations"] == 2
             if step.init_from:
                 assert arb.evolution["initial_network"]["file"] == spec.step(step.init_from).out
+        elif step.run == "settled":
+            source = step.repertoire_file or out / spec.step(step.repertoire).out
+            assert load_settled(path, Repertoire.load(source)).shape[1] == 3
         else:
             assert len(Repertoire.load(path)) > 0
     # Run again: every step is found finished and skipped.

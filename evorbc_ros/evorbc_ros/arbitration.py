@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from evorbc_ros.adaptation import AdaptationSettings, OnlineAdaptation, outcome_table
+from evorbc_ros.adaptation.settled import SettledError, load_settled, settled_path
 from evorbc_ros.arbitrator import Arbitrator, ArbitratorFile, DirectController
 from evorbc_ros.defaults import default_arbitrator, default_repertoire
 from evorbc_ros.laser import InputError
@@ -102,6 +103,23 @@ class Controller:
         rep = self.repertoire
         recorded = outcome_table(rep.behaviour, rep.heading)
         self.adaptation = OnlineAdaptation(recorded, rep.eval_time, settings, expected)
+
+    def settled_outcomes(self, path: str = "") -> np.ndarray:
+        """``(n, 3)`` the repertoire's settled outcomes, read from their file.
+
+        What each primitive does once its actuators hold its command ``(dx m, dy m,
+        dheading rad)`` over the repertoire's evaluation time, for
+        :meth:`enable_adaptation`'s ``expected`` (docs/design/adaptation.md, "What an
+        observation is compared with"). ``path``: the file; "" the one beside the
+        repertoire (``NAME.settled.json``, written by ``evorbc-evolve settled``).
+
+        Raises:
+            SettledError: a standard-NEAT controller, or a file that is missing, bad or
+                made for another repertoire (one line naming it).
+        """
+        if self.repertoire is None:
+            raise SettledError("settled outcomes need an EvoRBC controller (with a repertoire)")
+        return load_settled(path or settled_path(self.repertoire_path), self.repertoire)
 
     def disable_adaptation(self) -> None:
         """Stop adapting and forget what was learned: choices are the evolved ones again."""

@@ -21,11 +21,9 @@ import numpy as np
 from evorbc_ros.adaptation import AdaptationSettings, outcome_table
 from evorbc_ros.adaptation.model import OutcomeModel
 from evorbc_ros.adaptation.online import settings_arrays
+from evorbc_ros.adaptation.settled import EXPECTED
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.maze_task.kernel import Adapting
-
-#: What an observation is compared with.
-EXPECTED = ("recorded", "settled")
 
 
 def expected_outcomes(repertoire: Repertoire, robot, expected: str) -> np.ndarray | None:
@@ -41,7 +39,7 @@ def expected_outcomes(repertoire: Repertoire, robot, expected: str) -> np.ndarra
     from sim_bridge.four_ws.motion import MotionLimits
     from sim_bridge.four_ws.steady import settled_outcomes
 
-    if not isinstance(robot.limits, MotionLimits):
+    if not isinstance(getattr(robot, "limits", None), MotionLimits):  # legged: no limits
         raise ValueError(f"adaptation expected settled: only for 4WS robots, not {robot.name}")
     return settled_outcomes(robot.commands(repertoire.genes), robot.limits, repertoire.eval_time)
 
