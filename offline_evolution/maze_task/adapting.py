@@ -41,7 +41,7 @@ def expected_outcomes(repertoire: Repertoire, robot, expected: str) -> np.ndarra
     from sim_bridge.four_ws.motion import MotionLimits
     from sim_bridge.four_ws.steady import settled_outcomes
 
-    if not isinstance(robot.limits, MotionLimits):
+    if not isinstance(getattr(robot, "limits", None), MotionLimits):
         raise ValueError(f"adaptation expected settled: only for 4WS robots, not {robot.name}")
     return settled_outcomes(robot.commands(repertoire.genes), robot.limits, repertoire.eval_time)
 
