@@ -10,10 +10,13 @@ would observe of the evolved behaviour (docs/design/adaptation.md, "Legged robot
 Prints, for the episodes: how often the controller switches primitive and how long it
 holds one; the rule's tolerances; the share of held cycles (``k`` >= 2 of the same
 primitive) the rule accepts and why the others fail (agreement with the cycle before,
-too little translation); observations and distinct primitives observed per episode; and
-how far a held cycle's motion, extended to ``T`` (``adaptation.motion.extend_arc``), is
-from the primitive's recorded outcome, against the same over whole runs of at least ``L``
-cycles (``--runs``): whether longer executions average the gait's oscillation out.
+too little translation); observations and distinct primitives observed per episode, with
+the default (wheeled) settings and with the robot family's
+(:func:`~evorbc_ros.adaptation.settings_for`); and how far a held cycle's motion, extended
+to ``T`` (``adaptation.motion.extend_arc``), is from the primitive's recorded outcome,
+against the same over ``L`` cycles after a run's first (``--runs``): whether longer
+executions average the gait's oscillation out. For scale: the median distance from a
+primitive to its nearest other one in the same metric.
 
     python bench/legged_observations.py [--robot hexapod] [--starts 2] [--generated N]
         [--perturb SET] [--out FILE.json]
@@ -23,12 +26,14 @@ from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import asdict
 
 import numpy as np
 
-from evorbc_ros.adaptation import AdaptationSettings, OnlineAdaptation, outcome_table
+from evorbc_ros.adaptation import AdaptationSettings, OnlineAdaptation, outcome_table, settings_for
 from evorbc_ros.adaptation.motion import extend_arc, relative_motion
 from evorbc_ros.adaptation.online import settings_arrays
+from evorbc_ros.arbitration import robot_family
 from evorbc_ros.mapping import NO_PRIMITIVE
 from offline_evolution.reporters import Reporters
 from offline_evolution.runs.evaluate import EvaluateRun, run_suites
@@ -44,18 +49,29 @@ def _distance(motion: np.ndarray, outcome: np.ndarray, weight: np.ndarray) -> fl
     return float(np.sqrt((((motion - outcome) * weight) ** 2).sum()))
 
 
-def episode_figures(path, choice, recorded, weight, horizon, dt, settings, runs_of) -> dict:
+def _nearest(recorded: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """``(n,)`` each primitive's distance to its nearest other one (outcome-matching metric)."""
+    d = np.sqrt((((recorded[:, None] - recorded[None, :]) * weight) ** 2).sum(axis=-1))
+    np.fill_diagonal(d, np.inf)
+    return d.min(axis=1)
+
+
+def episode_figures(
+    path, choice, recorded, weight, horizon, dt, settings, family_settings, runs_of
+) -> dict:
     """One episode's figures (see the module docstring)."""
     choice = choice[: len(path) - 1]  # a robot that fell stops its trace early
     online = OnlineAdaptation(recorded, horizon, settings)
+    family = OnlineAdaptation(recorded, horizon, family_settings)
     pos_tol, head_tol = online.tolerance
     held = agree = moving = 0
     cycle_err, run_err = [], {k: [] for k in runs_of}
     last, k_run, run_start = None, 0, 0
     for t, ran in enumerate(choice):
-        online.put_pose(round(t * dt * 1e9), *map(float, path[t]))
-        online.before_choice()
-        online.after_choice(int(ran))
+        for a in (online, family):
+            a.put_pose(round(t * dt * 1e9), *map(float, path[t]))
+            a.before_choice()
+            a.after_choice(int(ran))
         k_run = k_run + 1 if t and ran == choice[t - 1] else 1
         if k_run == 1:
             run_start, last = t, None
@@ -74,11 +90,13 @@ def episode_figures(path, choice, recorded, weight, horizon, dt, settings, runs_
         if ends and ran != NO_PRIMITIVE:
             n = t + 1 - run_start
             for k in runs_of:
-                if n >= k:  # the run's first k cycles, as one execution of k cycles
-                    m = _extended(path[run_start], path[run_start + k], k, dt, horizon)
+                if n > k:  # k cycles after the run's first, as one execution of k cycles
+                    a, b = path[run_start + 1], path[run_start + 1 + k]
+                    m = _extended(a, b, k, dt, horizon)
                     run_err[k].append(_distance(m, recorded[ran], weight))
-    online.put_pose(round(len(choice) * dt * 1e9), *map(float, path[len(choice)]))
-    online.before_choice()
+    for a in (online, family):
+        a.put_pose(round(len(choice) * dt * 1e9), *map(float, path[len(choice)]))
+        a.before_choice()
     return {
         "cycles": len(choice),
         "switches": int(np.sum(choice[1:] != choice[:-1])),
@@ -87,6 +105,8 @@ def episode_figures(path, choice, recorded, weight, horizon, dt, settings, runs_
         "moving": int(moving),
         "observations": online.model.observations,
         "observed": online.model.used,
+        "family_observations": family.model.observations,
+        "family_observed": family.model.used,
         "cycle_err": cycle_err,
         "run_err": run_err,
     }
@@ -110,8 +130,9 @@ def main() -> None:
     weight = 1.0 / (recorded.max(axis=0) - recorded.min(axis=0))
     settings = AdaptationSettings()
     conf, _ = settings_arrays(recorded, rep.eval_time, settings)
+    family = settings_for(robot_family(args.robot))
     eps = [
-        episode_figures(p, c, recorded, weight, rep.eval_time, dt, settings, args.runs)
+        episode_figures(p, c, recorded, weight, rep.eval_time, dt, settings, family, args.runs)
         for p, c in zip(runs.suite.paths, runs.suite.choices, strict=True)
     ]
     cycles = sum(e["cycles"] for e in eps)
@@ -145,6 +166,10 @@ def main() -> None:
         "held_moving_pct": round(100 * sum(e["moving"] for e in eps) / max(held, 1), 1),
         "observations_per_episode": [e["observations"] for e in eps],
         "primitives_observed_per_episode": [e["observed"] for e in eps],
+        "family_settings": asdict(family),
+        "family_observations_per_episode": [e["family_observations"] for e in eps],
+        "family_primitives_observed_per_episode": [e["family_observed"] for e in eps],
+        "nearest_neighbour_distance_p50": round(float(np.median(_nearest(recorded, weight))), 3),
         "held_cycle_error_p50_p90": q(cycle_err),
         "run_error_p50_p90": {
             k: {
