@@ -13,7 +13,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from evorbc_ros.adaptation import AdaptationSettings, OnlineAdaptation, outcome_table
+from evorbc_ros.adaptation import (
+    AdaptationSettings,
+    OnlineAdaptation,
+    adapted_choice,
+    outcome_table,
+    settings_for,
+)
 from evorbc_ros.adaptation.settled import SettledError, load_settled, settled_path
 from evorbc_ros.arbitrator import Arbitrator, ArbitratorFile, DirectController
 from evorbc_ros.defaults import default_arbitrator, default_repertoire
@@ -24,6 +30,13 @@ from evorbc_ros.repertoire import Repertoire
 #: The label of the empty primitive an arbitrator sends when it is deactivated (stop the
 #: robot), which tells it from a cycle's "no primitive" (docs/design.md section 9).
 DEACTIVATED = "deactivated"
+
+
+def robot_family(robot: str) -> str:
+    """The registry's family of ``robot`` ("" for a robot it does not know)."""
+    from evorbc_ros.robots import registry
+
+    return registry.lookup(robot).family if registry.known(robot) else ""
 
 
 class InputGroups:
@@ -90,7 +103,9 @@ class Controller:
         """Start adapting, from the prior (docs/design.md section 24).
 
         Args:
-            settings: the model's; default :class:`AdaptationSettings`.
+            settings: the model's; default the robot family's
+                (:func:`~evorbc_ros.adaptation.settings_for`: legged robots observe
+                whole 0.5 s executions).
             expected: ``(n, 3)`` what each primitive's settled cycles should read on the
                 robot the repertoire was made on, over its evaluation time ``(dx m, dy m,
                 dheading rad)``; default the recorded outcomes.
@@ -101,6 +116,8 @@ class Controller:
         if self.repertoire is None:
             raise ValueError("adaptation needs an EvoRBC controller (with a repertoire)")
         rep = self.repertoire
+        if settings is None:
+            settings = settings_for(robot_family(self.spec.robot))
         recorded = outcome_table(rep.behaviour, rep.heading)
         self.adaptation = OnlineAdaptation(recorded, rep.eval_time, settings, expected)
 
@@ -185,13 +202,7 @@ class Controller:
             return (np.empty(0) if genes is None else genes), []
         index, m, x, y = self.arbitrator.choose_point(inputs)
         if self.adaptation is not None:
-            self.adaptation.before_choice()
-            if index != NO_PRIMITIVE:
-                # The grid's choice, and the centre of its cell, where the grid holds the
-                # brute-force nearest: with no correction either rule chooses as the
-                # grid, bit for bit (docs/design.md section 24).
-                index = self.adaptation.choose(*self.arbitrator.lookup.cell_centre(x, y), index)
-            self.adaptation.after_choice(index)
+            index = adapted_choice(self.adaptation, self.arbitrator.lookup, index, x, y)
         self.last_index = index
         row = [float(m[0]), float(m[1]), x, y, float(index)]
         if index == NO_PRIMITIVE:

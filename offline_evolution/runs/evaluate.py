@@ -198,19 +198,23 @@ def _adaptation(run: EvaluateRun, arb, task, repertoire):
     """
     if not run.adapt:
         return None
-    from evorbc_ros.adaptation import AdaptationSettings
+    from evorbc_ros.adaptation import settings_for
+    from evorbc_ros.arbitration import robot_family
     from offline_evolution.maze_task.adapting import adapting, expected_outcomes
 
     if not arb.kind.uses_repertoire:
         raise UserError("--adapt: adaptation corrects a repertoire; this is a standard controller")
     if not hasattr(task, "adapt"):
-        raise UserError(f"--adapt: {arb.robot}'s episodes do not adapt yet (4WS and "
-                        "differential-drive robots do; docs/design/adaptation.md)")  # fmt: skip
-    settings = AdaptationSettings()
+        raise UserError(f"--adapt: {arb.robot}'s episodes do not adapt yet (4WS, differential"
+                        "-drive and legged robots do; docs/design/adaptation.md)")  # fmt: skip
+    # The node's default for the robot (legged robots observe whole executions).
+    settings = settings_for(robot_family(arb.robot))
     try:
         expected = expected_outcomes(repertoire, task.robot, run.adapt_expected)
     except ValueError as e:
         raise UserError(f"--adapt-expected {run.adapt_expected}: {e}") from None
+    if hasattr(task, "adapting_for"):  # PyBullet episodes run the onboard classes
+        return settings, task.adapting_for(repertoire, settings, expected)
     return settings, adapting(repertoire, settings, task.dt, expected)
 
 
