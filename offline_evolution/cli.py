@@ -3,6 +3,7 @@
 Subcommands:
     repertoire   generate a MAP-Elites repertoire of locomotion primitives
     export-csv   convert a repertoire file to CSV
+    settled      a wheeled repertoire's settled outcomes, for the arbitrator node's adaptation
     arbitrator   evolve an EvoRBC arbitrator (NEAT) for a repertoire
     standard     evolve a standard-NEAT controller (the baseline)
     replay       run a controller in the mazes and report
@@ -32,6 +33,7 @@ from offline_evolution.commands import (
     repertoire,
     replay,
     robot_from_urdf,
+    settled,
 )
 from offline_evolution.runs.frame import one_line_errors
 from sim_bridge.cli_support import OneLineParser
@@ -47,6 +49,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     repertoire.add_parsers(sub)
+    settled.add_parsers(sub)
     arbitrator.add_parsers(sub)
     replay.add_parsers(sub)
     mazes.add_parsers(sub)

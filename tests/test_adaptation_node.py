@@ -6,6 +6,7 @@ other single-node tests (docs/design.md section 24).
 
 import math
 
+import pytest
 from diagnostic_msgs.msg import DiagnosticArray
 from nav_msgs.msg import Odometry
 from rclpy.parameter import Parameter
@@ -90,3 +91,42 @@ def test_adaptation_parameter_odometry_reset_and_diagnostics(ros):
     assert ros.spin_until(lambda: len(genes) == n + 1)
     assert node.set_parameters([Parameter("adaptation", value=True)])[0].successful
     assert node.controller.adaptation_state()["observations"] == 0
+
+
+def test_adaptation_expected_settled_reads_the_file_beside_the_repertoire_and_refuses_a_bad_one(
+    ros, tmp_path
+):
+    """``adaptation_expected: settled`` compares observations with the settled outcomes
+    shipped beside the repertoire; a bad file fails the configure, or refuses the live
+    change, in one line (docs/design/adaptation.md)."""
+    from evorbc_ros.adaptation.settled import load_settled, settled_path
+    from evorbc_ros.nodes.common import StartupError
+
+    node = ros.make(ArbitratorNode, adaptation=True, adaptation_expected="settled", **FAST)
+    rep = node.controller.repertoire
+    shipped = load_settled(settled_path(node.controller.repertoire_path), rep)
+    assert node.controller.adaptation.model.expected.tobytes() == shipped.tobytes()
+    assert node.health(0.0).values["adaptation: expected"] == "settled"
+    # Live: the value it has changes nothing; back to recorded starts again from the prior
+    # against the recorded outcomes.
+    model = node.controller.adaptation.model
+    assert node.set_parameters([Parameter("adaptation_expected", value="settled")])[0].successful
+    assert node.controller.adaptation.model is model
+    assert node.set_parameters([Parameter("adaptation_expected", value="recorded")])[0].successful
+    model = node.controller.adaptation.model
+    assert model.expected.tobytes() == model.recorded.tobytes() != shipped.tobytes()
+
+    bad = tmp_path / "bad.settled.json"
+    bad.write_text(settled_path(node.controller.repertoire_path).read_text()[:200])
+    problem = (
+        f"parameter adaptation_expected is settled, but {bad}: truncated settled outcomes file"
+    )
+    with pytest.raises(StartupError, match=f"^{problem}"):
+        ros.make(ArbitratorNode, adaptation_expected="settled", settled_outcomes=str(bad))
+    other = ros.make(ArbitratorNode, adaptation=True, settled_outcomes=str(bad), **FAST)
+    result = other.set_parameters([Parameter("adaptation_expected", value="settled")])[0]
+    assert not result.successful and result.reason.startswith(problem)
+    assert "\n" not in result.reason
+    assert other.get_parameter("adaptation_expected").value == "recorded"
+    model = other.controller.adaptation.model  # still adapting against the recorded ones
+    assert model.expected.tobytes() == model.recorded.tobytes()

@@ -53,24 +53,30 @@ def test_the_kernel_adapts_deterministically_and_changes_choices_only_when_on():
     np.testing.assert_array_equal(back.pose, off.pose)
 
 
-def test_the_lockstep_graph_adapting_drives_a_damaged_robot_as_the_offline_episode(tmp_path):
-    # The arbitrator node with its adaptation parameter on (recorded outcomes as expected,
-    # as the node has no others) against the kernel's adapted episode, with a stuck
-    # steering wheel: the same primitive at every cycle and the same poses, bit for bit.
+def _lockstep_adapted(tmp_path, domain, expected, episode_time, other=None):
+    """The lockstep graph, its arbitrator adapting against ``expected``, with a stuck
+    steering wheel, against the kernel's adapted episode: the same primitive at every
+    cycle and the same poses, bit for bit. Returns the graph's choices and the number of
+    cycles compared, and checks that they differ from the unadapted episode's and, with
+    ``other``, from the episode adapting against ``other``."""
     from graph_helpers import GraphRun, assert_same_choices
 
-    path, arb, task, rep, controller = _gaps_task()
+    path, arb, task, rep, controller = _gaps_task(episode_time)
     starts = task.nominal_starts()
     world = load_perturbations("4ws-stuck-steering").draw(np.random.default_rng([4, 1]), 1)
     plain = task.evaluate([arb.network], controller, starts, record=True, world=world)
-    task.adapt(adapting(rep, AdaptationSettings(), task.dt))
-    result = task.evaluate([arb.network], controller, starts, record=True, world=world)
+    episodes = {}
+    for e in filter(None, (other, expected)):
+        task.adapt(adapting(rep, AdaptationSettings(), task.dt, expected_outcomes(rep, task.robot, e)))  # noqa: E501  # fmt: skip
+        episodes[e] = task.evaluate([arb.network], controller, starts, record=True, world=world)
+    result = episodes[expected]
     # odom twice: the bridge starts once the adapting arbitrator has subscribed it too
     # (a first pose it missed would be sent again, and the other nodes answer twice).
     bridge = {"perturb": "4ws-stuck-steering", "seed": 4,
               "wait_for_subscribers": ["scan", "odom", "odom"]}  # fmt: skip
-    run = GraphRun(tmp_path, 187, "gaps", episode_time=25.0, arbitrator=path, bridge=bridge,
-                   arbitrator_params={"adaptation": True})  # fmt: skip
+    params = {"adaptation": True, **({"adaptation_expected": expected} if other else {})}
+    run = GraphRun(tmp_path, domain, "gaps", episode_time=episode_time, arbitrator=path,
+                   bridge=bridge, arbitrator_params=params)  # fmt: skip
     got = run.finish(timeout=120)
     choices = run.recorded_choices()
     cycles = assert_same_choices(choices, result)
@@ -78,8 +84,26 @@ def test_the_lockstep_graph_adapting_drives_a_damaged_robot_as_the_offline_episo
     np.testing.assert_array_equal(trajectory, result.pose[0, : cycles + 1])  # bit for bit
     n = min(cycles, plain.cycles[0])
     assert (choices[:n] != plain.choice[0, :n]).any()  # adaptation changed the choices
+    if other:
+        n = min(cycles, episodes[other].cycles[0])
+        assert (choices[:n] != episodes[other].choice[0, :n]).any()  # so did what it expects
     log = (tmp_path / "gaps-lockstep.log").read_text()
-    assert "adaptation on" in log and "stuck_steering: " in log
+    assert f"adaptation on: correcting outcomes from odometry (expected: {expected})" in log
+    assert "stuck_steering: " in log
+
+
+def test_the_lockstep_graph_adapting_drives_a_damaged_robot_as_the_offline_episode(tmp_path):
+    # The arbitrator node with its adaptation parameter on (recorded outcomes as expected,
+    # the node's default) against the kernel's adapted episode.
+    _lockstep_adapted(tmp_path, 187, "recorded", 25.0)
+
+
+def test_the_lockstep_graph_adapting_against_the_shipped_settled_outcomes_is_offline_s(tmp_path):
+    # adaptation_expected settled: the node reads the settled outcomes shipped beside the
+    # repertoire (evorbc-evolve settled), the kernel computes them with the 4WS model
+    # (evaluate --adapt-expected settled); the episodes are the same, bit for bit, and not
+    # the recorded one's (they part at cycle 8). 10 s keeps the graph's cost small.
+    _lockstep_adapted(tmp_path, 188, "settled", 10.0, other="recorded")
 
 
 def test_evaluate_adapt_reports_each_episode_with_and_without(tmp_path, capsys):
@@ -102,9 +126,11 @@ def test_evaluate_adapt_reports_each_episode_with_and_without(tmp_path, capsys):
 
 
 def test_evaluate_adapt_refuses_what_cannot_adapt_in_one_line(capsys):
-    assert main(["evaluate", "--robot", "hexapod", "--starts", "1", "--adapt"]) == 1
+    # Legged robots adapt (tests/test_legged_adaptation.py), against the recorded outcomes
+    # only: the settled ones are the 4WS model's.
+    args = ["evaluate", "--robot", "hexapod", "--starts", "1", "--adapt"]
+    assert main([*args, "--adapt-expected", "settled"]) == 1
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.endswith(
-        "--adapt: hexapod's episodes do not adapt yet (4WS and differential-drive robots do; "
-        "docs/design/adaptation.md)"
+        "--adapt-expected settled: adaptation expected settled: only for 4WS robots, not hexapod"
     )

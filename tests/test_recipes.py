@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from evorbc_ros.adaptation.settled import load_settled
 from evorbc_ros.arbitrator import ArbitratorFile
 from evorbc_ros.config import config_dir
 from evorbc_ros.repertoire import Repertoire
@@ -67,6 +68,9 @@ def test_each_recipe_runs_at_the_small_budget(recipe, tmp_path, capsys):
                 assert arb.evolution["initial_network"]["file"] == spec.step(step.init_from).out
             if step.init_from_file:
                 assert arb.evolution["initial_network"]["file"] == Path(step.init_from_file).name
+        elif step.run == "settled":
+            source = step.repertoire_file or out / spec.step(step.repertoire).out
+            assert load_settled(path, Repertoire.load(source)).shape[1] == 3
         else:
             assert len(Repertoire.load(path)) > 0
     # Run again: every step is found finished and skipped.

@@ -397,3 +397,22 @@ def test_adaptation_turns_on_the_arbitrator_s_and_the_bridge_waits_for_its_odom(
     assert bridge["wait_for_subscribers"] == ["scan", "odom", "odom"]
     assert "wait_for_subscribers" not in plain.node("sim_bridge").parameters
     assert graph_from_arguments({"adaptation": "true"}) == adapting
+
+
+def test_adaptation_expected_settled_is_the_arbitrator_s_parameter():
+    """evorbc-sim --adapt-expected settled, launch adaptation_expected:=settled: the
+    arbitrator reads the settled outcomes shipped beside the repertoire; the default
+    passes nothing, so a graph adapting as before is the same graph."""
+    settled = sim_graph(adaptation=True, adaptation_expected="settled")
+    assert settled.node("arbitrator").parameters["adaptation_expected"] == "settled"
+    assert "adaptation_expected" not in sim_graph(adaptation=True).node("arbitrator").parameters
+    given = {"adaptation": "true", "adaptation_expected": "settled"}
+    assert graph_from_arguments(given) == settled
+    assert (
+        bringup.parse_args(["--adapt", "--adapt-expected", "settled"]).adapt_expected == "settled"
+    )
+    with pytest.raises(
+        ConfigError,
+        match=r"^argument adaptation_expected must be recorded or settled, got .learned.$",
+    ):
+        graph_from_arguments({"adaptation_expected": "learned"})

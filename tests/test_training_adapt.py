@@ -76,7 +76,7 @@ def test_adapt_changes_training_under_damage_with_evaluates_adaptation(
     assert all(a is None for a in off_task.seen)
     # Every episode of the run adapted (training, nominal watch, post-selection), with the
     # adaptation evaluate --adapt builds for this task and repertoire.
-    expected = task_adapting(on_task, small_repertoire, "recorded")[1]
+    expected = task_adapting(on_task, small_repertoire, "recorded", "4ws-5")[1]
     assert on_task.seen and all(a is on_task.seen[0] for a in on_task.seen)
     for got, want in zip(on_task.seen[0], expected, strict=True):
         assert np.array_equal(got, want)
@@ -89,7 +89,7 @@ def test_adapt_expected_settled_compares_with_the_settled_outcomes(
     s = evolution_settings(small_neat_file, small_repertoire, task_values, generations=1)
     task = spy(s)
     evolve(s, small_repertoire, task=task)
-    settled = task_adapting(task, small_repertoire, "settled")[1].expected
+    settled = task_adapting(task, small_repertoire, "settled", "4ws-5")[1].expected
     assert np.array_equal(task.seen[0].expected, settled)
     assert not np.array_equal(settled, task.seen[0].recorded)
 

@@ -13,7 +13,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from evorbc_ros.adaptation import AdaptationSettings, OnlineAdaptation, outcome_table
+from evorbc_ros.adaptation import (
+    AdaptationSettings,
+    OnlineAdaptation,
+    adapted_choice,
+    outcome_table,
+    settings_for,
+)
+from evorbc_ros.adaptation.settled import SettledError, load_settled, settled_path
 from evorbc_ros.arbitrator import Arbitrator, ArbitratorFile, DirectController
 from evorbc_ros.defaults import default_arbitrator, default_repertoire
 from evorbc_ros.laser import InputError
@@ -23,6 +30,13 @@ from evorbc_ros.repertoire import Repertoire
 #: The label of the empty primitive an arbitrator sends when it is deactivated (stop the
 #: robot), which tells it from a cycle's "no primitive" (docs/design.md section 9).
 DEACTIVATED = "deactivated"
+
+
+def robot_family(robot: str) -> str:
+    """The registry's family of ``robot`` ("" for a robot it does not know)."""
+    from evorbc_ros.robots import registry
+
+    return registry.lookup(robot).family if registry.known(robot) else ""
 
 
 class InputGroups:
@@ -89,7 +103,9 @@ class Controller:
         """Start adapting, from the prior (docs/design.md section 24).
 
         Args:
-            settings: the model's; default :class:`AdaptationSettings`.
+            settings: the model's; default the robot family's
+                (:func:`~evorbc_ros.adaptation.settings_for`: legged robots observe
+                whole 0.5 s executions).
             expected: ``(n, 3)`` what each primitive's settled cycles should read on the
                 robot the repertoire was made on, over its evaluation time ``(dx m, dy m,
                 dheading rad)``; default the recorded outcomes.
@@ -100,8 +116,27 @@ class Controller:
         if self.repertoire is None:
             raise ValueError("adaptation needs an EvoRBC controller (with a repertoire)")
         rep = self.repertoire
+        if settings is None:
+            settings = settings_for(robot_family(self.spec.robot))
         recorded = outcome_table(rep.behaviour, rep.heading)
         self.adaptation = OnlineAdaptation(recorded, rep.eval_time, settings, expected)
+
+    def settled_outcomes(self, path: str = "") -> np.ndarray:
+        """``(n, 3)`` the repertoire's settled outcomes, read from their file.
+
+        What each primitive does once its actuators hold its command ``(dx m, dy m,
+        dheading rad)`` over the repertoire's evaluation time, for
+        :meth:`enable_adaptation`'s ``expected`` (docs/design/adaptation.md, "What an
+        observation is compared with"). ``path``: the file; "" the one beside the
+        repertoire (``NAME.settled.json``, written by ``evorbc-evolve settled``).
+
+        Raises:
+            SettledError: a standard-NEAT controller, or a file that is missing, bad or
+                made for another repertoire (one line naming it).
+        """
+        if self.repertoire is None:
+            raise SettledError("settled outcomes need an EvoRBC controller (with a repertoire)")
+        return load_settled(path or settled_path(self.repertoire_path), self.repertoire)
 
     def disable_adaptation(self) -> None:
         """Stop adapting and forget what was learned: choices are the evolved ones again."""
@@ -167,13 +202,7 @@ class Controller:
             return (np.empty(0) if genes is None else genes), []
         index, m, x, y = self.arbitrator.choose_point(inputs)
         if self.adaptation is not None:
-            self.adaptation.before_choice()
-            if index != NO_PRIMITIVE:
-                # The grid's choice, and the centre of its cell, where the grid holds the
-                # brute-force nearest: with no correction either rule chooses as the
-                # grid, bit for bit (docs/design.md section 24).
-                index = self.adaptation.choose(*self.arbitrator.lookup.cell_centre(x, y), index)
-            self.adaptation.after_choice(index)
+            index = adapted_choice(self.adaptation, self.arbitrator.lookup, index, x, y)
         self.last_index = index
         row = [float(m[0]), float(m[1]), x, y, float(index)]
         if index == NO_PRIMITIVE:

@@ -185,6 +185,22 @@ PARAMETERS: dict[str, tuple[ParamSpec, ...]] = {
             "corrected ones (docs/design.md section 24); false: as evolved, and forgets",
             live=True,
         ),
+        spec(
+            "adaptation_expected",
+            "recorded",
+            "what adaptation compares an observation with: recorded (the repertoire's "
+            "outcomes, measured from rest) or settled (what each primitive does once its "
+            "actuators hold its command, from settled_outcomes); a change while adapting "
+            "starts again from the prior",
+            choices=("recorded", "settled"),
+            live=True,
+        ),
+        spec(
+            "settled_outcomes",
+            "",
+            "settled-outcomes file (JSON, evorbc-evolve settled) read for adaptation_expected "
+            "settled; empty: the one beside the repertoire (NAME.settled.json)",
+        ),
         *MARKERS,
         *COMMON,
     ),

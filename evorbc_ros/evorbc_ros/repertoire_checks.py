@@ -72,33 +72,34 @@ class ColumnError(ValueError):
     """A column of primitives holds something other than numbers (message: the problem)."""
 
 
-def number_column(value: list, key: str, rows: bool) -> np.ndarray:
+def number_column(value: list, key: str, rows: bool, prefix: str = "primitives.") -> np.ndarray:
     """``value`` (a list of numbers, or of equal-length lists of numbers) as float64.
 
     Checks the type of every element first (in C, via ``map(type, ...)``), because numpy
     converts the strings "0.5" and booleans to floats without complaint.
 
     Raises:
-        ColumnError: naming ``primitives.<key>`` and what it holds instead.
+        ColumnError: naming ``<prefix><key>`` (``primitives.<key>``) and what it holds
+            instead.
 
     """
     try:
         if rows:
             kinds = set(map(type, value))
             if kinds - {list}:
-                raise ColumnError(f"primitives.{key} must be a list of lists of numbers")
+                raise ColumnError(f"{prefix}{key} must be a list of lists of numbers")
             kinds = set(map(type, chain.from_iterable(value)))
         else:
             kinds = set(map(type, value))
         if kinds - {int, float}:
             names = ", ".join(sorted(k.__name__ for k in kinds - {int, float}))
-            raise ColumnError(f"primitives.{key} must hold only numbers, it holds {names}")
+            raise ColumnError(f"{prefix}{key} must hold only numbers, it holds {names}")
         return np.asarray(value, dtype=np.float64)
     except (ValueError, OverflowError) as e:
         if isinstance(e, ColumnError):
             raise
         raise ColumnError(
-            f"primitives.{key} must be a rectangular array of numbers within float range"
+            f"{prefix}{key} must be a rectangular array of numbers within float range"
         ) from None
 
 

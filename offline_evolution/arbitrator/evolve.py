@@ -378,14 +378,14 @@ class Evolution:
             )
         if not hasattr(self.task, "adapt"):
             raise ConfigError(
-                f"training: adapt: {self.settings.robot}'s episodes do not adapt yet (4WS and "
-                "differential-drive robots do; docs/design/adaptation.md)"
+                f"training: adapt: {self.settings.robot}'s episodes do not adapt yet (4WS, "
+                "differential-drive and legged robots do; docs/design/adaptation.md)"
             )
         from offline_evolution.maze_task.adapting import task_adapting
 
         expected = training.get("adapt_expected", "recorded")
         try:
-            _, arrays = task_adapting(self.task, repertoire, expected)
+            _, arrays = task_adapting(self.task, repertoire, expected, self.settings.robot)
         except ValueError as e:
             raise ConfigError(f"training: adapt_expected {expected}: {e}") from None
         self.task.adapt(arrays)

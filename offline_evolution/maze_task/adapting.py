@@ -21,12 +21,9 @@ import numpy as np
 from evorbc_ros.adaptation import AdaptationSettings, outcome_table
 from evorbc_ros.adaptation.model import OutcomeModel
 from evorbc_ros.adaptation.online import settings_arrays
+from evorbc_ros.adaptation.settled import EXPECTED
 from evorbc_ros.repertoire import Repertoire
 from offline_evolution.maze_task.kernel import Adapting
-from offline_evolution.maze_task.training import ADAPT_EXPECTED
-
-#: What an observation is compared with.
-EXPECTED = ADAPT_EXPECTED
 
 
 def expected_outcomes(repertoire: Repertoire, robot, expected: str) -> np.ndarray | None:
@@ -42,7 +39,7 @@ def expected_outcomes(repertoire: Repertoire, robot, expected: str) -> np.ndarra
     from sim_bridge.four_ws.motion import MotionLimits
     from sim_bridge.four_ws.steady import settled_outcomes
 
-    if not isinstance(robot.limits, MotionLimits):
+    if not isinstance(getattr(robot, "limits", None), MotionLimits):  # legged: no limits
         raise ValueError(f"adaptation expected settled: only for 4WS robots, not {robot.name}")
     return settled_outcomes(robot.commands(repertoire.genes), robot.limits, repertoire.eval_time)
 
@@ -77,20 +74,29 @@ def adapting(
 
 
 def task_adapting(
-    task, repertoire: Repertoire, expected: str
-) -> tuple[AdaptationSettings, Adapting]:
-    """The default :class:`AdaptationSettings` and the kernel's adaptation for ``task``.
+    task, repertoire: Repertoire, expected: str, robot: str
+) -> tuple[AdaptationSettings, object]:
+    """The adaptation settings and arrays ``task``'s episodes adapt with (its ``adapt``).
 
     What ``evaluate --adapt`` and a training run with ``training: adapt: true`` give
-    :meth:`~offline_evolution.maze_task.task.MazeTask.adapt`: one code for both.
+    :meth:`~offline_evolution.maze_task.task.MazeTask.adapt`: one code for both. The
+    settings are the node's default for ``robot``'s family (legged robots observe whole
+    executions); a PyBullet task (``adapting_for``) runs the onboard classes, a kinematic
+    one the kernel's :func:`adapting`.
 
     Args:
-        task: a kinematic maze task (its ``robot`` and control period ``dt``, s).
+        task: a maze task whose episodes adapt (its ``robot`` and control period ``dt``, s).
         expected: ``recorded`` or ``settled`` (:func:`expected_outcomes`).
+        robot: the registered robot's name.
 
     Raises:
         ValueError: ``settled`` for a robot that is not 4WS, or an unknown ``expected``.
     """
-    settings = AdaptationSettings()
+    from evorbc_ros.adaptation import settings_for
+    from evorbc_ros.arbitration import robot_family
+
+    settings = settings_for(robot_family(robot))
     outcomes = expected_outcomes(repertoire, task.robot, expected)
+    if hasattr(task, "adapting_for"):  # PyBullet episodes run the onboard classes
+        return settings, task.adapting_for(repertoire, settings, outcomes)
     return settings, adapting(repertoire, settings, task.dt, outcomes)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from evorbc_ros.adaptation import outcome_table
 from evorbc_ros.config import ConfigError
 from evorbc_ros.controller_kinds import ControllerKind, controller_kind
 from evorbc_ros.network import NetworkSpec
@@ -24,7 +25,12 @@ from offline_evolution.maze_task.base import MazeTaskBase, MazeTaskSettings, emp
 from offline_evolution.maze_task.perturbation import PYBULLET_LEGGED
 from offline_evolution.task_protocol import EpisodeResult
 from sim_bridge.damage import LEGGED_DAMAGE
-from sim_bridge.legged.episode import EpisodeRunner, LeggedController, LeggedWorld
+from sim_bridge.legged.episode import (
+    EpisodeRunner,
+    LeggedAdaptation,
+    LeggedController,
+    LeggedWorld,
+)
 from sim_bridge.legged.pool import SpawnedWorkers, available_cores, ignore_sigint
 from sim_bridge.legged.scanner import Scanner
 from sim_bridge.legged.settings import LeggedRobotSettings, load_robot_settings
@@ -39,8 +45,9 @@ def _init_worker(world: LeggedWorld) -> None:
 
 
 def _run(runner: EpisodeRunner, job) -> dict:
-    network, controller, maze, start, record, world = job
-    return runner.run(NetworkSpec.from_dict(network), controller, maze, start, record, world)
+    network, controller, maze, start, record, world, adapt = job
+    net = NetworkSpec.from_dict(network)
+    return runner.run(net, controller, maze, start, record, world, adapt)
 
 
 def _episode(job) -> dict:
@@ -89,6 +96,25 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
         self.world = LeggedWorld(tuple(self.mazes), self.layout, robot, self.n_cycles)
         self.workers = max(1, workers or available_cores())
         self.cluster_workers = workers
+        #: EvoRBC episodes adapt with this (:meth:`adapt`), or not (None).
+        self.adapting: LeggedAdaptation | None = None
+        #: Per episode of the last :meth:`evaluate` while adapting: observations taken.
+        self.observations: list[int] = []
+
+    def adapting_for(self, repertoire: Repertoire, settings, expected=None) -> LeggedAdaptation:
+        """What :meth:`adapt` takes for an EvoRBC controller of ``repertoire``.
+
+        As :meth:`evorbc_ros.arbitration.Controller.enable_adaptation` builds its model:
+        the recorded outcomes over the repertoire's evaluation time; ``settings``
+        (:class:`~evorbc_ros.adaptation.AdaptationSettings`), ``expected`` ``(n, 3)`` or
+        None (the recorded outcomes).
+        """
+        recorded = outcome_table(repertoire.behaviour, repertoire.heading)
+        return LeggedAdaptation(recorded, float(repertoire.eval_time), settings, expected)
+
+    def adapt(self, adapting: LeggedAdaptation | None) -> None:
+        """Run EvoRBC episodes adapting onboard, each from the prior; None: not."""
+        self.adapting = adapting
 
     def describe(self) -> dict:
         """The simulated robot, as repertoire files record it."""
@@ -126,6 +152,12 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
         row per start (its start errors already applied to ``starts``), or None.
         """
         rows = [world.row(k) if world is not None else None for k in range(len(starts))]
+        adapt = self.adapting if controller.kind.uses_repertoire else None
+        if adapt is not None and len(adapt.recorded) != len(controller.genes):
+            raise ValueError(
+                f"adaptation of {len(adapt.recorded)} primitives, "
+                f"controller of {len(controller.genes)}"
+            )
         jobs = [
             (
                 net.to_dict(),
@@ -134,11 +166,13 @@ class LeggedMazeTask(MazeTaskBase, SpawnedWorkers):
                 tuple(map(float, row[1:4])),
                 record,
                 w,
+                adapt,
             )
             for net in networks
             for row, w in zip(starts, rows, strict=True)
         ]
         results = self._map(jobs)
+        self.observations = [r["observations"] for r in results] if adapt is not None else []
         reached = np.array([r["reached"] for r in results], dtype=bool)
         cycles = np.array([r["cycles"] for r in results], dtype=np.int64)
         final = np.array([r["final_distance"] for r in results])

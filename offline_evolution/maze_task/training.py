@@ -47,6 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from evorbc_ros.adaptation.settled import EXPECTED
 from evorbc_ros.config import ConfigError, build_settings, setting
 from offline_evolution.maze_task.perturbation import NONE, PerturbationSet, load_perturbations
 from offline_evolution.mazes.generator import (
@@ -70,7 +71,7 @@ GRID_CACHE = 128
 DISTANCES = ("euclidean", "path")
 #: What an adapting episode compares an observation with (``training.adapt_expected``,
 #: ``evaluate --adapt-expected``; docs/design/adaptation.md).
-ADAPT_EXPECTED = ("recorded", "settled")
+ADAPT_EXPECTED = EXPECTED
 #: Name prefix of training mazes (``train1-000042``): never a held-out maze's ``gen21021-``.
 PREFIX = "train"
 

@@ -27,7 +27,14 @@ from offline_evolution.recipes.budget import portable_task
 
 PROFILES = ("quick", "full")
 #: Run-settings keys a profile may set (the rest are the robot's own).
-RUN_KEYS = ("generations", "hall_of_fame", "post_samples", "nominal_watch", "snapshot_every")
+RUN_KEYS = (
+    "generations",
+    "hall_of_fame",
+    "post_samples",
+    "nominal_watch",
+    "snapshot_every",
+    "post_rule",
+)
 #: The arbitrator settings of a robot from a URDF (its declaration names the A1's).
 LEGGED_RUN = "arbitrator/a1.yaml"
 

@@ -42,6 +42,7 @@ from offline_evolution.recipes.spec import (
     Recipe,
     RepertoireStep,
     RobotFromUrdfStep,
+    SettledStep,
 )
 from offline_evolution.runs import arbitrator as arbitrator_runs
 from offline_evolution.runs import repertoire as repertoire_runs
@@ -106,7 +107,7 @@ def run_recipe(
             say(f"{head}: done in {took[0] / 60:.1f} min (CPU {took[1] / 60:.1f} min)")
             ran = True
         verdict = None
-        if budget == "full" and step.run in ("repertoire", "arbitrator", "copy"):
+        if budget == "full" and step.run in ("repertoire", "arbitrator", "copy", "settled"):
             verdict = Verdict.of(
                 target, step.sha256, step.content_sha256, step.recipe_content_sha256, step.shipped
             )
@@ -217,6 +218,12 @@ def _run_step(recipe: Recipe, step, out: Path, budget: str, workers, quiet: bool
         terminal.repertoire(run, workers, quiet)
     elif isinstance(step, ArbitratorStep):
         terminal.arbitrator(_arbitrator_run(recipe, step, out, budget, target), workers, quiet)
+    elif isinstance(step, SettledStep):
+        from offline_evolution.runs.settled import write_settled
+
+        write_settled(
+            step.repertoire_file or str(out / recipe.step(step.repertoire).out), str(target)
+        )
     else:  # pragma: no cover - the loader knows no other kind
         raise ConfigError(f"{recipe.path}: step {step.step}: unknown kind {step.run!r}")
 

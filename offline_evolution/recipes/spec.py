@@ -13,7 +13,9 @@ A recipe names its steps in order. Each step runs one kind of job and writes one
 * ``robot-from-urdf``: a legged robot's settings derived from a ``urdf``
   (``evorbc-evolve robot-from-urdf``); its ``out`` is ``NAME-model.yaml``;
 * ``design-gait``: the gait design search (``evorbc-evolve design-gait``) over the
-  settings an earlier step wrote (``settings_step``), at a ``budget`` with a ``seed``.
+  settings an earlier step wrote (``settings_step``), at a ``budget`` with a ``seed``;
+* ``settled``: the settled outcomes of a 4WS ``repertoire`` an earlier step wrote (or
+  ``repertoire_file``), for the arbitrator node's adaptation (``evorbc-evolve settled``).
 
 A repertoire step's robot is a registered ``robot``, a robot settings file
 (``robot_file``, its folder put on ``$EVORBC_ROBOT_PATH`` for the run) or the legged
@@ -38,7 +40,7 @@ from evorbc_ros.config import ConfigError, build_settings, load_yaml_mapping, se
 from evorbc_ros.robots.registry import ROBOT_NAMES
 
 #: Step kinds, by the value of a step's ``run`` key.
-KINDS = ("repertoire", "arbitrator", "copy", "robot-from-urdf", "design-gait")
+KINDS = ("repertoire", "arbitrator", "copy", "robot-from-urdf", "design-gait", "settled")
 #: What a step name and an output name may be: a plain file name, no folders.
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
 _SHA256 = re.compile(r"[0-9a-f]{64}")
@@ -129,14 +131,23 @@ class DesignGaitStep(_Common):
     budget: str = setting("quick", doc="the search's budget", choices=("quick", "full"))
 
 
+@dataclass(frozen=True, kw_only=True)
+class SettledStep(_Common):
+    """``evorbc-evolve settled REPERTOIRE --out OUT``."""
+
+    repertoire: str | None = setting(None, doc="the earlier step whose repertoire it uses")
+    repertoire_file: str | None = setting(None, doc="a repertoire file, if not a step's")
+
+
 _CLASSES = {
     "repertoire": RepertoireStep,
     "arbitrator": ArbitratorStep,
     "copy": CopyStep,
     "robot-from-urdf": RobotFromUrdfStep,
     "design-gait": DesignGaitStep,
+    "settled": SettledStep,
 }
-Step = RepertoireStep | ArbitratorStep | CopyStep | RobotFromUrdfStep | DesignGaitStep
+Step = RepertoireStep | ArbitratorStep | CopyStep | RobotFromUrdfStep | DesignGaitStep | SettledStep
 
 
 @dataclass(frozen=True)

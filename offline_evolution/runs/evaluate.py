@@ -203,10 +203,10 @@ def _adaptation(run: EvaluateRun, arb, task, repertoire):
     if not arb.kind.uses_repertoire:
         raise UserError("--adapt: adaptation corrects a repertoire; this is a standard controller")
     if not hasattr(task, "adapt"):
-        raise UserError(f"--adapt: {arb.robot}'s episodes do not adapt yet (4WS and "
-                        "differential-drive robots do; docs/design/adaptation.md)")  # fmt: skip
+        raise UserError(f"--adapt: {arb.robot}'s episodes do not adapt yet (4WS, differential"
+                        "-drive and legged robots do; docs/design/adaptation.md)")  # fmt: skip
     try:
-        return task_adapting(task, repertoire, run.adapt_expected)
+        return task_adapting(task, repertoire, run.adapt_expected, arb.robot)
     except ValueError as e:
         raise UserError(f"--adapt-expected {run.adapt_expected}: {e}") from None
 

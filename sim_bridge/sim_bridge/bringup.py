@@ -20,6 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from evorbc_ros.adaptation.settled import EXPECTED
 from evorbc_ros.arbitration import Controller
 from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.config import ConfigError
@@ -97,6 +98,14 @@ def parse_args(argv=None) -> argparse.Namespace:
         action="store_true",
         help="the arbitrator corrects its primitives' outcomes from odometry while driving "
         "(its adaptation parameter; docs/adaptation.md), as evaluate --adapt does offline",
+    )
+    p.add_argument(
+        "--adapt-expected",
+        choices=EXPECTED,
+        default="recorded",
+        help="what adaptation compares an observation with (its adaptation_expected "
+        "parameter): the recorded outcomes (default) or the settled ones shipped beside the "
+        "repertoire, as evaluate --adapt-expected",
     )
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--plot", default="", help="trajectory picture (default: <maze>-run.png)")
@@ -203,6 +212,7 @@ def start_graph(
         bag=args.bag,
         maze_scale=args.maze_scale,
         adaptation=args.adapt,
+        adaptation_expected=args.adapt_expected,
     )
     procs = [graph.start(node, spec.namespace) for node in spec.nodes]
     return procs[-1]  # the bridge, started last: it waits for the others anyway

@@ -24,6 +24,7 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from evorbc_ros.adaptation.settled import EXPECTED
 from evorbc_ros.config import ConfigError, config_dir
 from evorbc_ros.defaults import default_arbitrator, paper_arbitrator, ships_controller
 from evorbc_ros.robots import registry
@@ -89,6 +90,13 @@ ARGUMENTS = (
         "false",
         "true: the arbitrator corrects its primitives' outcomes from odometry while driving "
         "(docs/adaptation.md), as evaluate --adapt does offline",
+    ),
+    Argument(
+        "adaptation_expected",
+        "recorded",
+        "what adaptation compares an observation with: recorded (the repertoire's outcomes) "
+        "or settled (read from the settled-outcomes file beside the repertoire), as "
+        "evaluate --adapt-expected",
     ),
     Argument(
         "namespace",
@@ -286,6 +294,7 @@ def sim_graph(
     bag: str = "",
     maze_scale: float = 0.0,
     adaptation: bool = False,
+    adaptation_expected: str = "recorded",
 ) -> SimGraph:
     """The graph that runs ``arbitrator`` (default: the one shipped for ``robot``) in a maze.
 
@@ -298,16 +307,21 @@ def sim_graph(
     ``adaptation``: the arbitrator's ``adaptation`` parameter on; the bridge then waits for
     two subscribers of ``odom`` (the radar node's and the arbitrator's), so that in lockstep
     the arbitrator sees the first pose and the episode is the offline one
-    (docs/design/adaptation.md).
+    (docs/design/adaptation.md). ``adaptation_expected``: the arbitrator's parameter of
+    that name (``recorded`` or ``settled``; passed only when not ``recorded``).
 
     Raises:
-        ConfigError: an unknown robot or mode, or ``paper`` with ``arbitrator`` (one line
-            naming the argument).
+        ConfigError: an unknown robot, mode or ``adaptation_expected``, or ``paper`` with
+            ``arbitrator`` (one line naming the argument).
     """
     if not registry.known(robot):
         raise ConfigError(f"robot must be one of {', '.join(registry.names())}, got {robot!r}")
     if mode not in MODES:
         raise ConfigError(f"mode must be lockstep or realtime, got {mode!r}")
+    if adaptation_expected not in EXPECTED:
+        raise ConfigError(
+            f"adaptation_expected must be recorded or settled, got {adaptation_expected!r}"
+        )
     if paper and arbitrator:
         raise ConfigError(
             "paper cannot be combined with arbitrator: paper picks the paper-protocol "
@@ -338,6 +352,8 @@ def sim_graph(
     )
     ready = {"wait_for_ready": ["recorder/ready"]} if bag else {}
     adapting = {"adaptation": True} if adaptation else {}
+    if adaptation_expected != "recorded":  # an intact graph passes the parameters it did
+        adapting["adaptation_expected"] = adaptation_expected
     if adaptation:  # a topic named twice needs two subscribers
         ready["wait_for_subscribers"] = [*bridge_default("wait_for_subscribers"), "odom"]
     return SimGraph(
@@ -423,6 +439,7 @@ def graph_from_arguments(values: dict[str, str]) -> SimGraph:
             paper=paper,
             bag=given["bag"],
             adaptation=adaptation,
+            adaptation_expected=given["adaptation_expected"],
         )
     except ConfigError as e:
         raise ConfigError(f"argument {e}") from None

@@ -5,7 +5,19 @@ functions the offline kernels can compile with numba; :mod:`~evorbc_ros.adaptati
 keeps the model's arrays and :mod:`~evorbc_ros.adaptation.online` feeds it from odometry.
 """
 
-from evorbc_ros.adaptation.model import AdaptationSettings, OutcomeModel, outcome_table
-from evorbc_ros.adaptation.online import OnlineAdaptation
+from evorbc_ros.adaptation.model import (
+    AdaptationSettings,
+    OutcomeModel,
+    outcome_table,
+    settings_for,
+)
+from evorbc_ros.adaptation.online import OnlineAdaptation, adapted_choice
 
-__all__ = ["AdaptationSettings", "OnlineAdaptation", "OutcomeModel", "outcome_table"]
+__all__ = [
+    "AdaptationSettings",
+    "OnlineAdaptation",
+    "OutcomeModel",
+    "adapted_choice",
+    "outcome_table",
+    "settings_for",
+]

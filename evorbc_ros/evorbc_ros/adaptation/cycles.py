@@ -15,9 +15,11 @@ State of one controller:
   odometry's fixed frame, the pose at the last choice, the last cycle's motion over ``T``
   ``(dx m, dy m, dheading rad)`` and the settled motion summed so far in its first pose's
   frame.
-- ``conf`` (float64 ``(3,)``): position tolerance (m over ``T``), heading tolerance (rad
-  over ``T``), ``T`` (s); ``iconf`` (int64 ``(3,)``): ``settle_cycles``, ``window``,
-  matching (:data:`MATCH_OUTCOME` or :data:`MATCH_POINT`).
+- ``conf`` (float64 ``(4,)``): position tolerance (m over ``T``), heading tolerance (rad
+  over ``T``), ``T`` (s), the fewest settled cycles an observation sums (``min_cycles``);
+  ``iconf`` (int64 ``(4,)``): ``settle_cycles``, ``window``, matching
+  (:data:`MATCH_OUTCOME` or :data:`MATCH_POINT`), which cycles are settled
+  (:data:`STEADY_AGREE` or :data:`STEADY_HELD`).
 - the model's arrays (:meth:`~evorbc_ros.adaptation.model.OutcomeModel.arrays`) and its
   noise, and ``weight`` ``(3,)`` (1 / each outcome dimension's extent).
 """
@@ -41,10 +43,15 @@ N_INTS = 9
 POSE, ANCHOR, LAST, SUM = 0, 3, 6, 9
 N_FLOATS = 12
 # Rows of ``conf`` and ``iconf``.
-POS_TOL, HEAD_TOL, HORIZON = 0, 1, 2
-SETTLE, WINDOW, MATCH = 0, 1, 2
+POS_TOL, HEAD_TOL, HORIZON, MIN_CYCLES = 0, 1, 2, 3
+SETTLE, WINDOW, MATCH, STEADY = 0, 1, 2, 3
 #: ``iconf[MATCH]``: the settings' ``match``.
 MATCH_OUTCOME, MATCH_POINT = 0, 1
+#: ``iconf[STEADY]``: the settings' ``steady``. ``agree``: a cycle is settled when its
+#: motion agrees with the cycle before's (a wheeled robot holding its command); ``held``:
+#: every cycle after ``settle_cycles`` is, and ``min_cycles`` of them are summed, so that a
+#: gait's oscillation within its period averages out (docs/design/adaptation.md).
+STEADY_AGREE, STEADY_HELD = 0, 1
 
 
 def new_state() -> tuple[np.ndarray, np.ndarray]:
@@ -88,8 +95,11 @@ def put_pose(ints, floats, stamp_ns, x, y, yaw):
 
 def flush(ints, floats, conf, features, recorded, expected, kzx, slots, residual, inverse,
           alpha, correction, corrected, counts, noise):  # fmt: skip
-    """Give the summed settled motion, if any, to the model (:func:`gp.observe`)."""
-    if ints[SUM_CYCLES] > 0 and ints[RUNNING] >= 0:
+    """Give the summed settled motion, if any, to the model (:func:`gp.observe`).
+
+    A sum of fewer than ``min_cycles`` cycles is dropped.
+    """
+    if ints[SUM_CYCLES] >= conf[MIN_CYCLES] and ints[SUM_CYCLES] > 0 and ints[RUNNING] >= 0:
         o0, o1, o2 = extend_arc(
             floats[SUM], floats[SUM + 1], floats[SUM + 2], ints[SUM_NS] * 1e-9, conf[HORIZON]
         )
@@ -102,10 +112,11 @@ def before_choice(ints, floats, conf, iconf, features, recorded, expected, kzx, 
                   residual, inverse, alpha, correction, corrected, counts, noise):  # fmt: skip
     """Attribute the motion since the last choice to the primitive chosen then.
 
-    A cycle is observed once its primitive ran more than ``settle_cycles`` choices, and its
-    motion over ``T`` translated more than the position tolerance and agrees with the cycle
-    before's within the tolerances; up to ``window`` such cycles are summed into one
-    observation (docs/design/adaptation.md).
+    A cycle is observed once its primitive ran more than ``settle_cycles`` choices, and
+    (``steady`` ``agree``) its motion over ``T`` translated more than the position tolerance
+    and agrees with the cycle before's within the tolerances; up to ``window`` such cycles
+    are summed into one observation, given to the model if it sums at least
+    ``min_cycles`` (docs/design/adaptation.md).
     """
     p, a = POSE, ANCHOR
     if ints[HAS_ANCHOR] == 0 or ints[HAS_POSE] == 0 or ints[POSE_STAMP] <= ints[ANCHOR_STAMP]:
@@ -126,7 +137,7 @@ def before_choice(ints, floats, conf, iconf, features, recorded, expected, kzx, 
     floats[LAST + 2] = bh
     ints[HAS_LAST] = 1
     pos = conf[POS_TOL]
-    steady = (
+    steady = iconf[STEADY] == STEADY_HELD or (
         had_last
         and math.hypot(bx, by) > pos
         and math.hypot(lx - bx, ly - by) <= pos

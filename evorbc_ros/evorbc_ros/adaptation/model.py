@@ -19,6 +19,8 @@ from evorbc_ros.adaptation import gp
 MAX_CAPACITY = 256
 #: How the network's choice is matched against the corrected outcomes.
 MATCHES = ("outcome", "point")
+#: Which cycles are settled (:mod:`evorbc_ros.adaptation.cycles`, ``STEADY_*``).
+STEADY_RULES = ("agree", "held")
 
 
 @dataclass(frozen=True)
@@ -37,6 +39,12 @@ class AdaptationSettings:
             heading over its extent): the actuators have settled (unitless). A cycle that
             translates less than that over ``T`` is not observed.
         window: settled cycles summed into one observation (at most; a switch ends it).
+        steady: which cycles are settled: ``agree``, those whose motion agrees with the
+            cycle before's (a wheeled robot whose actuators hold the command); ``held``,
+            every cycle after ``settle_cycles`` (a gait, whose 0.1 s cycles never agree:
+            its oscillation within a period averages out over ``min_cycles``).
+        min_cycles: the fewest settled cycles an observation sums; a shorter execution
+            is not observed.
         match: ``outcome``: the primitive whose corrected outcome is nearest the
             recorded outcome of the primitive the grid chose (what the network asked
             for), each dimension over the repertoire's extent in it; ``point``: the one
@@ -51,6 +59,8 @@ class AdaptationSettings:
     steady_tolerance: float = 0.02
     window: int = 5
     match: str = "outcome"
+    steady: str = "agree"
+    min_cycles: int = 1
 
     def __post_init__(self) -> None:
         checks = (
@@ -60,12 +70,32 @@ class AdaptationSettings:
             ("settle_cycles", 0 <= self.settle_cycles <= 1000, "between 0 and 1000"),
             ("steady_tolerance", 0.0 <= self.steady_tolerance <= 10.0, "in [0, 10]"),
             ("window", 1 <= self.window <= 1000, "between 1 and 1000"),
+            ("min_cycles", 1 <= self.min_cycles <= self.window, "between 1 and window"),
         )
         if self.match not in MATCHES:
             raise ValueError(f"adaptation match must be one of {', '.join(MATCHES)}")
+        if self.steady not in STEADY_RULES:
+            raise ValueError(f"adaptation steady must be one of {', '.join(STEADY_RULES)}")
         for name, ok, what in checks:
             if not ok:
                 raise ValueError(f"adaptation {name} must be {what}, got {getattr(self, name)!r}")
+
+
+#: A legged robot's settings: its 0.1 s cycles never agree within ``steady_tolerance`` (the
+#: body sways and yaws within each gait period), so every held cycle after the first is
+#: summed and an observation is a whole ``min_cycles`` = ``window`` = 5 cycles (0.5 s, half
+#: to more than one period of a 1-2.5 Hz gait). Measured on the training mazes
+#: (docs/design/adaptation.md, "Legged robots").
+LEGGED_SETTINGS = AdaptationSettings(steady="held", window=5, min_cycles=5)
+
+
+#: The registry's families whose robots walk (docs/legged.md).
+LEGGED_FAMILIES = ("hexapod", "legged")
+
+
+def settings_for(family: str) -> AdaptationSettings:
+    """The default settings of a robot of ``family`` (the registry's): legged or not."""
+    return LEGGED_SETTINGS if family in LEGGED_FAMILIES else AdaptationSettings()
 
 
 def outcome_table(behaviour: np.ndarray, heading: np.ndarray) -> np.ndarray:

@@ -89,6 +89,26 @@ class OnlineAdaptation:
         )  # fmt: skip
 
 
+def adapted_choice(adaptation: OnlineAdaptation, lookup, index: int, x: float, y: float) -> int:
+    """One control cycle of an adapting EvoRBC controller: the primitive to run.
+
+    Attributes the motion since the last choice to the primitive chosen then, matches the
+    grid's choice ``index`` (``-1``: none) given at the centre of the grid cell of the
+    mapping's point ``(x, y)`` (m), where the grid holds the brute-force nearest, so that
+    with no correction either rule chooses as the grid, bit for bit (docs/design.md section
+    24), and records the choice. :meth:`evorbc_ros.arbitration.Controller.step` and the
+    legged robots' offline episodes both call it (docs/design/adaptation.md).
+
+    Args:
+        lookup: the controller's :class:`~evorbc_ros.mapping.PrimitiveLookup`.
+    """
+    adaptation.before_choice()
+    if index >= 0:
+        index = adaptation.choose(*lookup.cell_centre(x, y), index)
+    adaptation.after_choice(index)
+    return index
+
+
 def settings_arrays(
     recorded: np.ndarray, horizon: float, settings: AdaptationSettings
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -99,7 +119,15 @@ def settings_arrays(
     """
     extent = recorded.max(axis=0) - recorded.min(axis=0)
     tol = settings.steady_tolerance
-    conf = np.array([tol * float(max(extent[0], extent[1])), tol * float(extent[2]), horizon])
+    conf = np.array(
+        [
+            tol * float(max(extent[0], extent[1])),
+            tol * float(extent[2]),
+            horizon,
+            float(settings.min_cycles),
+        ]
+    )
     match = cycles.MATCH_OUTCOME if settings.match == "outcome" else cycles.MATCH_POINT
-    iconf = np.array([settings.settle_cycles, settings.window, match], dtype=np.int64)
+    steady = cycles.STEADY_AGREE if settings.steady == "agree" else cycles.STEADY_HELD
+    iconf = np.array([settings.settle_cycles, settings.window, match, steady], dtype=np.int64)
     return conf, iconf

@@ -22,6 +22,14 @@ whose outcome, corrected from what the primitives did, is nearest what the netwo
 choice was recorded to do (docs/design.md section 24). ``~/reset_adaptation``
 (std_srvs/Empty) forgets the observations. Its state is in the health report, and the
 chosen primitive's corrected displacement in the markers.
+
+``adaptation_expected`` (applied live) is what an observation is compared with:
+``recorded``, the repertoire's outcomes (the default), or ``settled``, what each primitive
+does once its actuators hold its command, read from the file ``settled_outcomes`` (empty:
+``NAME.settled.json`` beside the repertoire; ``evorbc-evolve settled`` writes it). That file
+is checked when ``settled`` is asked for: at configure, a missing, bad or mismatched file
+fails the configure in one line; set live, it refuses the change with that line, and the
+node goes on as it was. A change while adapting starts again from the prior.
 """
 
 from __future__ import annotations
@@ -33,10 +41,12 @@ import sys
 
 import numpy as np
 from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import SetParametersResult
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Empty
 from visualization_msgs.msg import MarkerArray
 
+from evorbc_ros.adaptation.settled import SettledError
 from evorbc_ros.arbitration import DEACTIVATED, Controller, InputGroups
 from evorbc_ros.arbitrator import ArbitratorError
 from evorbc_ros.defaults import default_arbitrator, no_shipped_controller, ships_controller
@@ -82,7 +92,12 @@ class ArbitratorNode(ManagedNode):
         self.odom_sub = None  # made when adaptation starts
         self.pose_fresh = False  # a pose came since the last choice (adaptation only)
         self.poses = Meter()
+        self.expected = "recorded"  # adaptation_expected
+        self.settled_file = ""  # settled_outcomes, as configured
+        self.settled: np.ndarray | None = None  # (n, 3) read once settled is asked for
         super().__init__(**kwargs)
+        # Checked before rclpy takes the value, so a bad file refuses the change itself.
+        self.add_on_set_parameters_callback(self.check_expected)
         self.reset_service = self.create_service(Empty, "~/reset", self.on_reset)
         self.reset_adaptation_service = self.create_service(
             Empty, "~/reset_adaptation", self.on_reset_adaptation
@@ -115,6 +130,9 @@ class ArbitratorNode(ManagedNode):
             self.markers = Markers(self, params["marker_frame"], pub)
         for t in self.groups.sizes:
             self.subscription(Float64MultiArray, t, lambda msg, t=t: self.on_input(t, msg))
+        self.expected, self.settled_file = params["adaptation_expected"], params["settled_outcomes"]
+        if self.expected == "settled" and self.controller.repertoire is not None:
+            self.settled = self.read_settled()  # a bad file fails the configure
         if params["adaptation"]:
             self.start_adaptation()
         self.get_logger().info(
@@ -152,30 +170,75 @@ class ArbitratorNode(ManagedNode):
         """Close the record file; drop the subscriptions, publishers and controller."""
         self.release_made()
         self.pub = self.map_pub = self.markers = self.odom_sub = None
+        self.settled = None
         if self.record is not None:
             self.record.close()
             self.record = None
         self.controller = None
 
+    def read_settled(self) -> np.ndarray:
+        """``(n, 3)`` the settled outcomes of ``settled_outcomes`` (or beside the repertoire).
+
+        Raises:
+            StartupError: one line naming the parameter and the file's problem.
+        """
+        try:
+            return self.controller.settled_outcomes(self.settled_file)
+        except SettledError as e:
+            raise StartupError(f"parameter adaptation_expected is settled, but {e}") from None
+
     def start_adaptation(self) -> None:
-        """Adapt from the prior; subscribe odometry (once).
+        """Adapt from the prior, against ``adaptation_expected``; subscribe odometry (once).
 
         Raises:
             StartupError: a standard-NEAT controller (no primitives to correct).
         """
+        expected = self.settled if self.expected == "settled" else None
         try:
-            self.controller.enable_adaptation()
+            self.controller.enable_adaptation(expected=expected)
         except ValueError as e:
             raise StartupError(f"parameter adaptation: {e}") from None
         if self.odom_sub is None:
             self.odom_sub = self.subscription(Odometry, "odom", self.on_odom, SENSOR_DATA)
         self.pose_fresh = False
-        self.get_logger().info("adaptation on: correcting outcomes from odometry")
+        self.get_logger().info(
+            f"adaptation on: correcting outcomes from odometry (expected: {self.expected})"
+        )
+
+    def check_expected(self, params: list) -> SetParametersResult:
+        """Refuse ``adaptation_expected: settled`` when its file cannot be used (configured).
+
+        Unconfigured, any valid value is taken: configure reads the file.
+        """
+        for p in params:
+            if p.name != "adaptation_expected" or p.value != "settled":
+                continue
+            if self.controller is None or self.controller.repertoire is None:
+                continue  # configure reads it; a standard controller does not adapt
+            if self.settled is None:
+                try:
+                    self.settled = self.read_settled()
+                except StartupError as e:
+                    return SetParametersResult(successful=False, reason=str(e))
+        return SetParametersResult(successful=True)
 
     def apply_live(self, name: str, value) -> None:
-        """``adaptation``: true starts from the prior; false stops and forgets."""
-        if name != "adaptation" or self.controller is None:
+        """``adaptation``: true starts from the prior; false stops and forgets.
+
+        ``adaptation_expected``: while adapting, starts again from the prior against the
+        new expected outcomes (the observations were compared with the others).
+        """
+        if self.controller is None:
             return  # before configure: configure reads it
+        if name == "adaptation_expected":
+            if value == self.expected:
+                return  # set to what it is (ros2 param load): keep what was learned
+            self.expected = value
+            if self.controller.adaptation is not None:
+                self.start_adaptation()
+            return
+        if name != "adaptation":
+            return
         if value and self.controller.adaptation is None:
             try:
                 self.start_adaptation()
@@ -317,6 +380,7 @@ class ArbitratorNode(ManagedNode):
         h.add("failed choices", self.failures.count)
         if self.controller is not None and self.controller.adaptation is not None:
             report_input(h, "odometry", self.poses, now, STALE)
+            h.add("adaptation: expected", self.expected)
             for key, value in self.controller.adaptation_state().items():
                 h.add(f"adaptation: {key}", value)
         if new_halts:

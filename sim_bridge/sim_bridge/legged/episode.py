@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from evorbc_ros.adaptation import AdaptationSettings, OnlineAdaptation, adapted_choice
 from evorbc_ros.controller_kinds import ControllerKind, controller_kind, direct_genes
 from evorbc_ros.goal import GoalInputs, yaw_from_quaternion
 from evorbc_ros.laser import LaserToRangefinders
@@ -65,6 +66,25 @@ class LeggedController:
 
 
 @dataclass(frozen=True)
+class LeggedAdaptation:
+    """An EvoRBC controller's onboard adaptation, as the arbitrator node builds it (picklable).
+
+    ``recorded``: ``(n, 3)`` the repertoire's outcomes ``(dx m, dy m, dheading rad)`` over
+    ``horizon`` s (:func:`evorbc_ros.adaptation.outcome_table`); ``expected``: ``(n, 3)``
+    what an observation should read, or None (the recorded outcomes, as the node has).
+    """
+
+    recorded: np.ndarray
+    horizon: float
+    settings: AdaptationSettings
+    expected: np.ndarray | None = None
+
+    def start(self) -> OnlineAdaptation:
+        """A fresh model: each episode starts from the prior."""
+        return OnlineAdaptation(self.recorded, self.horizon, self.settings, self.expected)
+
+
+@dataclass(frozen=True)
 class LeggedWorld:
     """Everything an episode needs besides the controller (picklable)."""
 
@@ -90,13 +110,19 @@ class _Chooser:
             self.lookup = PrimitiveLookup.build(controller.behaviour, self.mapping.domain())
         self.settings = settings
 
-    def choose(self, out: np.ndarray) -> tuple[int, LeggedGaitTable | None, np.ndarray]:
+    def choose(
+        self, out: np.ndarray, adaptation: OnlineAdaptation | None = None
+    ) -> tuple[int, LeggedGaitTable | None, np.ndarray]:
         """``(primitive index or -1, gait table, row)`` for one activation.
 
         No table (None) when the outputs are not finite: no primitive runs this cycle.
+        ``adaptation``: an EvoRBC controller's, fed this cycle's pose; it matches the
+        grid's choice as :meth:`evorbc_ros.arbitration.Controller.step` does.
         """
         if self.kind.uses_repertoire:
-            index = choose_primitive(self.mapping, self.lookup, out[0], out[1])[0]
+            index, x, y = choose_primitive(self.mapping, self.lookup, out[0], out[1])
+            if adaptation is not None:
+                index = adapted_choice(adaptation, self.lookup, index, x, y)
             if index == NO_PRIMITIVE:
                 return index, None, np.array([0])
             return index, self.table, np.array([index])
@@ -167,17 +193,23 @@ class EpisodeRunner:
         start: tuple[float, float, float],
         record: bool = False,
         world: dict | None = None,
+        adaptation: LeggedAdaptation | None = None,
     ) -> dict:
         """One episode from ``start`` ``(x, y, heading)`` in maze ``maze_index`` (or a Maze).
 
         ``world``: a perturbed world's row
-        (:meth:`~sim_bridge.perturbation.WorldDraw.row`), or None.
+        (:meth:`~sim_bridge.perturbation.WorldDraw.row`), or None. ``adaptation``: an
+        EvoRBC controller adapting from the prior, fed each cycle as the arbitrator node
+        is in a lockstep graph: the odometry pose of the body at the cycle's start (the
+        bridge's ``odom``: position and the yaw of PyBullet's orientation, stamped
+        ``round(cycle x period)`` ns), then the choice (docs/design/adaptation.md).
 
         Returns:
             ``{"reached", "fell", "cycles", "final_distance", "initial_distance", "start_xy",
             "end_xy"}`` (distances and positions in m, the body's first and last x, y) and,
             with ``record``, ``"pose" (cycles + 1, 3)``, ``"choice" (cycles,)`` and
-            ``"outputs" (cycles, n_outputs)``.
+            ``"outputs" (cycles, n_outputs)``; with ``adaptation``, ``"observations"``
+            and ``"observed"`` (primitives in the model) at the end.
 
         """
         maze, sim = self.sims.get(maze_index)  # a task maze's index or a generated maze
@@ -204,11 +236,20 @@ class EpisodeRunner:
         held = sim.joint_states()[0]  # before any primitive: where the joints stand
         latency = int(world["latency_cycles"]) if world else 0
         queue = collections.deque([(NO_PRIMITIVE, None, np.array([0]))] * latency)
+        online = adaptation.start() if adaptation is not None else None
+        period = self.world.settings.control_period
         with perturbed_sim(sim, world):
             for cycle in range(self.world.n_cycles):
                 out = net.activate(self.inputs(sim, maze, base, world, cycle))
+                if online is None:
+                    choice = chooser.choose(out)
+                else:
+                    (px, py, _), orn = base
+                    yaw = yaw_from_quaternion(*orn)
+                    online.put_pose(round(cycle * period * 1e9), px, py, yaw)
+                    choice = chooser.choose(out, online)
                 # Latency: the choice made ``latency`` cycles ago acts now (none before).
-                queue.append(chooser.choose(out))
+                queue.append(choice)
                 index, table, row = queue.popleft()
                 if table is not None:
                     if gait_start is None:
@@ -245,6 +286,9 @@ class EpisodeRunner:
             "start_xy": start_xy,
             "end_xy": (x, y),
         }
+        if online is not None:
+            result["observations"] = online.model.observations
+            result["observed"] = online.model.used
         if record:
             result["pose"] = np.array(poses)
             result["choice"] = np.array(choices, dtype=np.int64)

@@ -1,0 +1,139 @@
+"""Measure: onboard adaptation of a shipped legged controller on the held-out mazes.
+
+For each set (intact and the robot's damage sets) runs ``evorbc-evolve evaluate --robot R
+--generated G --starts S --perturb SET --adapt`` (``offline_evolution.runs.evaluate.run_suites``,
+the command's own code: the held-out generated mazes, seed 21021, never tuned on; starts
+and worlds seed 0; the robot family's default
+:class:`~evorbc_ros.adaptation.AdaptationSettings`, the node's) and reports reach and mean
+time to the target without and with adaptation, the episodes won and lost, the loss
+against the intact robot without adaptation and its share with adaptation (issue 42's
+target: at most half; intact: at most 2 points), falls, observations per adapted episode
+and reach per damaged leg or side. ``--out FILE.json`` writes the figures
+(docs/results/adaptation/).
+
+    python bench/adaptation_legged.py [--robot hexapod] [--generated 10] [--starts 4]
+        [--sets none hexapod-leg-lost ...] [--out docs/results/adaptation/hexapod.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from dataclasses import asdict
+
+import numpy as np
+
+from evorbc_ros.atomic_io import atomic_write_text
+from offline_evolution.maze_task.evaluation import summarise
+from offline_evolution.reporters import Reporters
+from offline_evolution.runs.evaluate import EvaluateRun, run_suites
+
+#: The damage sets of each legged robot (config/perturbations/).
+DAMAGE = {
+    "hexapod": ("hexapod-leg-lost", "hexapod-knee-locked", "hexapod-weak-side"),
+    "a1": ("a1-weak-leg", "a1-knee-locked"),
+}
+
+
+def reach(episodes) -> dict:
+    """Reached share (%), falls and mean time to the target (s) of the episodes reached."""
+    row = summarise(episodes, "")
+    times = [e.time for e in episodes if e.reached]
+    return {
+        "episodes": row["episodes"],
+        "reached": row["reached"],
+        "reach_pct": round(100 * row["reach_rate"], 2),
+        "mean_time_s": round(float(np.mean(times)), 2) if times else math.nan,
+        "falls": row["falls"],
+    }
+
+
+def measure(robot: str, name: str, generated: int, starts: int) -> dict:
+    """One set's figures (see the module docstring)."""
+    run = EvaluateRun(robot=robot, generated=generated, starts=starts, perturb=name, adapt=True)
+    began = time.monotonic()
+    runs = run_suites(run, Reporters([]))
+    off, on = runs.suite.episodes, runs.adapted.episodes
+    observations = runs.task.observations  # of the adapted suite, the last one run
+    pairs = list(zip(off, on, strict=True))
+    paths = zip(runs.suite.choices, runs.adapted.choices, strict=True)
+    per_part = {}
+    for part in sorted({e.damaged_part for e in off if e.damaged_part}):
+        idx = [k for k, e in enumerate(off) if e.damaged_part == part]
+        per_part[part] = {
+            "off": reach([off[k] for k in idx]),
+            "on": reach([on[k] for k in idx]),
+        }
+    return {
+        "set": name,
+        "off": reach(off),
+        "on": reach(on),
+        "won": sum(b.reached and not a.reached for a, b in pairs),
+        "lost": sum(a.reached and not b.reached for a, b in pairs),
+        "observations_per_episode": round(float(np.mean(observations)), 2),
+        "episodes_observed_pct": round(100 * float(np.mean(np.array(observations) > 0)), 1),
+        "changed_episodes": sum(not np.array_equal(a, b) for a, b in paths),
+        **({"per_part": per_part} if per_part else {}),
+        "settings": asdict(runs.settings),
+        "wall_s": round(time.monotonic() - began, 1),
+    }
+
+
+def with_losses(results: list[dict]) -> list[dict]:
+    """Each set's loss (reach points below the intact robot without adaptation) and share."""
+    intact = next(r for r in results if r["set"] == "none")["off"]["reach_pct"]
+    for r in results:
+        off, on = intact - r["off"]["reach_pct"], intact - r["on"]["reach_pct"]
+        r["loss_off"], r["loss_on"] = round(off, 2), round(on, 2)
+        r["loss_share"] = round(on / off, 3) if off > 0 else None
+    return results
+
+
+def print_table(results: list[dict]) -> None:
+    """The markdown table of docs/adaptation.md."""
+    print("| set | without | with | won / lost | loss without / with (share) | obs. / episode |")
+    print("|---|---|---|---|---|---|")
+    for r in results:
+        share = f" ({100 * r['loss_share']:.0f} %)" if r["loss_share"] is not None else ""
+        print(
+            f"| {r['set']} | {r['off']['reach_pct']:.1f} %, {r['off']['mean_time_s']:.1f} s "
+            f"| {r['on']['reach_pct']:.1f} %, {r['on']['mean_time_s']:.1f} s "
+            f"| {r['won']} / {r['lost']} | {r['loss_off']:.1f} / {r['loss_on']:.1f}{share} "
+            f"| {r['observations_per_episode']:.1f} |"
+        )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--robot", default="hexapod", choices=sorted(DAMAGE))
+    parser.add_argument("--generated", type=int, default=10)
+    parser.add_argument("--starts", type=int, default=4)
+    parser.add_argument("--sets", nargs="+", default=None, help="default: none and the damage")
+    parser.add_argument("--out", help="write the figures as JSON")
+    args = parser.parse_args()
+    sets = args.sets or ["none", *DAMAGE[args.robot]]
+    if "none" not in sets:
+        parser.error("--sets: the losses are against 'none', the intact robot")
+    results = []
+    for name in sets:
+        results.append(measure(args.robot, name, args.generated, args.starts))
+        print(json.dumps(results[-1]), flush=True)
+    with_losses(results)
+    print_table(results)
+    if args.out:
+        out = {
+            "command": f"bench/adaptation_legged.py --robot {args.robot} --generated "
+            f"{args.generated} --starts {args.starts}",
+            "robot": args.robot,
+            "generated": {"count": args.generated, "seed": 21021},
+            "starts_per_maze": args.starts,
+            "seed": 0,
+            "sets": results,
+        }
+        atomic_write_text(args.out, json.dumps(out, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    main()
