@@ -10,6 +10,7 @@ from conftest import SMALL_TASK, evolution_settings
 
 from evorbc_ros.config import ConfigError
 from offline_evolution.arbitrator.evolve import evolve
+from offline_evolution.arbitrator.post_scores import scores_key
 from offline_evolution.arbitrator.selection import post_evaluation_starts, selection_world
 from offline_evolution.maze_task.adapting import task_adapting
 from offline_evolution.maze_task.perturbation import perturbation_dir
@@ -138,6 +139,10 @@ def test_selection_world_draws_one_seeded_world_per_start():
     off = task(perturb=DAMAGE)
     same, none = selection_world(off, starts, 3)
     assert none is None and same is starts
+    # A resumed post-selection never takes rows of the other world: the key tells them
+    # apart even where the set moves no start.
+    assert scores_key([], starts, world) != scores_key([], starts)
+    assert scores_key([], starts, world) == scores_key([], starts, world2)
 
 
 def test_new_keys_are_recorded_only_when_set():

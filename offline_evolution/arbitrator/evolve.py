@@ -519,7 +519,7 @@ class Evolution:
         candidates = self.hall.candidates()
         starts = post_evaluation_starts(self.task, self.settings.seed, self.settings.post_samples)
         starts, world = selection_world(self.task, starts, self.settings.seed)
-        key = scores_key(candidates, starts)
+        key = scores_key(candidates, starts, world)
         if self.post_scores is None or self.post_scores.key != key:
             # none yet, or saved for another hall or other starts (post_samples changed)
             self.post_scores = PostScores(key)

@@ -27,12 +27,15 @@ import numpy as np
 from offline_evolution.arbitrator.neat_state import require
 
 
-def scores_key(candidates: list[dict], starts: np.ndarray) -> str:
+def scores_key(candidates: list[dict], starts: np.ndarray, world=None) -> str:
     """What a set of post-evaluation scores is of: the candidates' genomes and the starts.
 
     Args:
         candidates: the hall of fame's genomes in order (``neat_state.genome_to_dict``).
         starts: (episodes, 4) the post-evaluation's starts (maze index, x m, y m, heading rad).
+        world: the starts' worlds (``training: post_perturb``), or None (nominal: the key
+            is the one before worlds existed). A damage set may move no start, so the
+            worlds' draws are part of the key.
 
     Returns:
         A SHA-256 hex digest; scores saved under another key are of another post-evaluation
@@ -42,6 +45,10 @@ def scores_key(candidates: list[dict], starts: np.ndarray) -> str:
     starts = np.ascontiguousarray(starts, dtype=np.float64)
     h.update(repr(starts.shape).encode())
     h.update(starts.tobytes())
+    if world is not None:
+        h.update(np.ascontiguousarray(world.keys, dtype=np.int64).tobytes())
+        for name in sorted(world.values):
+            h.update(name.encode() + np.ascontiguousarray(world.values[name], float).tobytes())
     return h.hexdigest()
 
 
