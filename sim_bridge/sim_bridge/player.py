@@ -97,6 +97,10 @@ def positive_seconds(text: str) -> float:
     return value
 
 
+#: s of wall time between the graph's match and the first cycle (see Player.connect).
+MATCH_GRACE = 0.3
+
+
 class Player(Node):
     """Publishes a recording's cycles in lockstep and collects the arbitrator's choices."""
 
@@ -156,6 +160,16 @@ class Player(Node):
             raise PlaybackError(
                 f"{topics['goal']}: the goal was not taken within {self.timeout:g} s"
             )
+        # The sensor nodes take scan and odom best effort (sensor-data QoS): a message
+        # that reaches a reader before the reader's side of the match completes is
+        # dropped, not resent, and cycle 0 would then never be answered (seen once under
+        # load 9). Give the far ends the moment the bridge gives them (bridge_node
+        # wait_for_graph, 0.3 s of wall time) before the first cycle.
+        until = time.monotonic() + MATCH_GRACE
+        while time.monotonic() < until:
+            if not running():
+                raise KeyboardInterrupt
+            self.executor_.spin_once(timeout_sec=STOP_POLL)
 
     def play(self) -> list[np.ndarray]:
         """Every cycle in lockstep; returns the arbitrator's choice for each."""
