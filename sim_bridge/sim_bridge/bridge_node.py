@@ -70,6 +70,7 @@ from evorbc_ros.nodes.diagnostics import DiagnosticsPublisher
 from evorbc_ros.nodes.parameters import ParameterGuard, declare_all
 from evorbc_ros.robots import registry
 from sim_bridge.bridge_parameters import PARAMETERS, REMOVED
+from sim_bridge.rejoins import RejoinWatch
 from sim_bridge.verdict import episode_verdict
 
 #: Topics of the graph besides the commands: each has exactly one publisher in one run.
@@ -407,8 +408,6 @@ class SimBridgeNode(Node):
         connections are reliable, so nothing is sent again (docs/design.md section 9).
         """
         sent = checked = time.monotonic()
-        node_left = False
-        known = self.endpoints()
         while not all(self.fresh.values()) and running():
             executor.spin_once(timeout_sec=0.01)
             now = time.monotonic()
@@ -416,16 +415,12 @@ class SimBridgeNode(Node):
             if now - checked > 0.1:
                 checked = now
                 gone = self.missing()
-                if gone and not node_left:
+                seen = self.rejoins.check(gone, self.endpoints)
+                if seen == "left":
                     self.get_logger().warning(f"lost {', '.join(gone)}; waiting for it")
-                node_left = node_left or bool(gone)
-                if node_left and not gone:
-                    node_left = False
-                    back = self.endpoints()
-                    rejoined = bool(back - known)
-                    known = back
-                    if not rejoined:
-                        self.get_logger().info("it is back with the same endpoints; waiting")
+                elif seen == "back":
+                    self.get_logger().info("it is back with the same endpoints; waiting")
+                rejoined = seen == "new"
             if rejoined or now - sent > self.lockstep_timeout:
                 if rejoined:
                     self.spin_for(executor, 0.3)  # let the new node's connections settle
@@ -440,6 +435,7 @@ class SimBridgeNode(Node):
         try:
             self.wait_for_graph(executor)
             self.check_alone()
+            self.rejoins = RejoinWatch(self.endpoints())
             self.loop_start = time.monotonic()
             while not self.world.status().done and running():
                 self.fresh = dict.fromkeys(self.fresh, False)
