@@ -14,6 +14,7 @@ import pytest
 import yaml
 from rclpy.lifecycle import TransitionCallbackReturn
 from rclpy.parameter import Parameter
+from rclpy.qos import ReliabilityPolicy
 from ros_helpers import ros_with_args
 from std_msgs.msg import Float64MultiArray
 
@@ -25,6 +26,7 @@ from evorbc_ros.nodes.laser_sensor import LaserSensorNode
 from evorbc_ros.nodes.primitive_executor import PrimitiveExecutorNode
 from evorbc_ros.nodes.radar_sensor import RadarSensorNode
 from sim_bridge import bridge_parameters, recorder
+from sim_bridge.graph import sim_graph
 
 NODES = {
     "laser_sensor": LaserSensorNode,
@@ -273,3 +275,28 @@ def test_wheel_radius_is_applied_live_and_validated(ros):
     # 0 means the robot's own again.
     assert node.set_parameters([Parameter("wheel_radius", value=0.0)])[0].successful
     assert node.wheel_radius == 0.02
+
+
+def subscription_reliability(node, topic):
+    (info,) = node.get_subscriptions_info_by_topic(topic)
+    return info.qos_profile.reliability
+
+
+@pytest.mark.parametrize("cls, topic", [(LaserSensorNode, "/scan"), (RadarSensorNode, "/odom")])
+def test_sensor_streams_are_best_effort_unless_input_qos_is_reliable(ros, cls, topic):
+    # Best effort takes any driver's stream; a lockstep graph asks for reliable, so a
+    # first message that arrives before the reader's side of the match is not dropped.
+    assert subscription_reliability(ros.make(cls), topic) == ReliabilityPolicy.BEST_EFFORT
+
+
+@pytest.mark.parametrize("cls, topic", [(LaserSensorNode, "/scan"), (RadarSensorNode, "/odom")])
+def test_input_qos_reliable_subscribes_reliably(ros, cls, topic):
+    node = ros.make(cls, input_qos="reliable")
+    assert subscription_reliability(node, topic) == ReliabilityPolicy.RELIABLE
+
+
+def test_the_lockstep_graph_asks_its_nodes_for_reliable_inputs():
+    lockstep, realtime = sim_graph(maze="gaps"), sim_graph(maze="gaps", mode="realtime")
+    for name in ("laser_sensor", "radar_sensor", "arbitrator"):
+        assert lockstep.node(name).parameters["input_qos"] == "reliable"
+        assert "input_qos" not in realtime.node(name).parameters  # the node's default

@@ -26,6 +26,8 @@ from sim_bridge.graph import (
 
 ROOT = Path(__file__).resolve().parents[1]
 NODES_FILE = config_dir() / "ros" / "arbitrator.yaml"
+#: A lockstep graph's sensor nodes and arbitrator take scan and odom reliably.
+RELIABLE_INPUTS = {"input_qos": "reliable"}
 
 
 def params(graph):
@@ -43,9 +45,14 @@ def test_the_default_graph_runs_the_shipped_4ws_5_controller_in_obstacle():
         "sim_bridge",
     ]
     assert params(graph) == {
-        "laser_sensor": {"use_sim_time": True, "sensor_layout": arb},
-        "radar_sensor": {"use_sim_time": True, "sensor_layout": arb},
-        "arbitrator": {"use_sim_time": True, "arbitrator": arb, "robot": "4ws-5"},
+        "laser_sensor": {"use_sim_time": True, "sensor_layout": arb, **RELIABLE_INPUTS},
+        "radar_sensor": {"use_sim_time": True, "sensor_layout": arb, **RELIABLE_INPUTS},
+        "arbitrator": {
+            "use_sim_time": True,
+            "arbitrator": arb,
+            "robot": "4ws-5",
+            **RELIABLE_INPUTS,
+        },
         "primitive_executor": {"use_sim_time": True, "robot": "4ws-5", "lockstep": True},
         "sim_bridge": {
             "robot": "4ws-5",

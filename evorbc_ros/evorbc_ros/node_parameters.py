@@ -135,6 +135,15 @@ _LAYOUT = spec(
     "",
     "sensor layout YAML or arbitrator JSON; empty: the shipped 4ws-5 controller's",
 )
+#: The nodes that take the sensor streams ``scan`` and ``odom``.
+_INPUT_QOS = spec(
+    "input_qos",
+    "sensor_data",
+    "QoS of the scan and odom subscriptions: sensor_data (best effort, as drivers publish) "
+    "or reliable (a lockstep graph, so that no first message is lost to a match still "
+    "completing; docs/design.md section 9)",
+    choices=("sensor_data", "reliable"),
+)
 _TWO_PI = 2.0 * math.pi
 
 PARAMETERS: dict[str, tuple[ParamSpec, ...]] = {
@@ -143,6 +152,7 @@ PARAMETERS: dict[str, tuple[ParamSpec, ...]] = {
         spec("laser_x", 0.0, "scanner position on the robot, x forward (m)", -10.0, 10.0),
         spec("laser_y", 0.0, "scanner position on the robot, y left (m)", -10.0, 10.0),
         spec("laser_yaw", 0.0, "scanner yaw in the robot frame (rad)", -_TWO_PI, _TWO_PI),
+        _INPUT_QOS,
         *MARKERS,
         *COMMON,
     ),
@@ -154,6 +164,7 @@ PARAMETERS: dict[str, tuple[ParamSpec, ...]] = {
             "goal message type: point (PointStamped) or pose (PoseStamped)",
             choices=("point", "pose"),
         ),
+        _INPUT_QOS,
         *MARKERS,
         *COMMON,
     ),
@@ -201,6 +212,7 @@ PARAMETERS: dict[str, tuple[ParamSpec, ...]] = {
             "settled-outcomes file (JSON, evorbc-evolve settled) read for adaptation_expected "
             "settled; empty: the one beside the repertoire (NAME.settled.json)",
         ),
+        _INPUT_QOS,
         *MARKERS,
         *COMMON,
     ),

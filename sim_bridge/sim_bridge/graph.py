@@ -354,13 +354,16 @@ def sim_graph(
     adapting = {"adaptation": True} if adaptation else {}
     if adaptation_expected != "recorded":  # an intact graph passes the parameters it did
         adapting["adaptation_expected"] = adaptation_expected
+    # Lockstep answers each state once: a first scan or odometry lost to a best-effort
+    # match still completing would never be answered (docs/design.md section 9).
+    inputs = {"input_qos": "reliable"} if mode == "lockstep" else {}
     if adaptation:  # a topic named twice needs two subscribers
         ready["wait_for_subscribers"] = [*bridge_default("wait_for_subscribers"), "odom"]
     return SimGraph(
         (
             *([recorder] if bag else []),
-            evorbc("laser_sensor", sensor_layout=arbitrator),
-            evorbc("radar_sensor", sensor_layout=arbitrator),
+            evorbc("laser_sensor", sensor_layout=arbitrator, **inputs),
+            evorbc("radar_sensor", sensor_layout=arbitrator, **inputs),
             evorbc(
                 "arbitrator",
                 managed=True,
@@ -369,6 +372,7 @@ def sim_graph(
                 robot=robot,
                 record_file=record_file,
                 **adapting,
+                **inputs,
             ),
             evorbc("primitive_executor", managed=True, robot=robot, lockstep=mode == "lockstep"),
             NodeSpec(

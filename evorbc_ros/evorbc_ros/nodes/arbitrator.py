@@ -56,8 +56,8 @@ from evorbc_ros.laser import InputError
 from evorbc_ros.marker_geometry import primitive_arrows
 from evorbc_ros.nodes.common import (
     DIAGNOSTICS,
-    SENSOR_DATA,
     StartupError,
+    input_qos,
     load_sensor_layout,
     now_seconds,
     robot_named,
@@ -131,6 +131,7 @@ class ArbitratorNode(ManagedNode):
         for t in self.groups.sizes:
             self.subscription(Float64MultiArray, t, lambda msg, t=t: self.on_input(t, msg))
         self.expected, self.settled_file = params["adaptation_expected"], params["settled_outcomes"]
+        self.odom_qos = input_qos(params["input_qos"])
         if self.expected == "settled" and self.controller.repertoire is not None:
             self.settled = self.read_settled()  # a bad file fails the configure
         if params["adaptation"]:
@@ -199,7 +200,7 @@ class ArbitratorNode(ManagedNode):
         except ValueError as e:
             raise StartupError(f"parameter adaptation: {e}") from None
         if self.odom_sub is None:
-            self.odom_sub = self.subscription(Odometry, "odom", self.on_odom, SENSOR_DATA)
+            self.odom_sub = self.subscription(Odometry, "odom", self.on_odom, self.odom_qos)
         self.pose_fresh = False
         self.get_logger().info(
             f"adaptation on: correcting outcomes from odometry (expected: {self.expected})"

@@ -52,6 +52,17 @@ LATCHED = QoSProfile(
 SENSOR_DATA = qos_profile_sensor_data
 
 
+def input_qos(name: str) -> QoSProfile:
+    """The QoS of a sensor stream's subscription for the ``input_qos`` parameter's value.
+
+    ``sensor_data`` takes what drivers publish (best effort). ``reliable`` is for a lockstep
+    graph, whose publishers are reliable: a best-effort reader drops a message that reaches
+    it before its side of the match completes, and a lockstep cycle lost so is never
+    answered (docs/design.md section 9).
+    """
+    return RELIABLE if name == "reliable" else SENSOR_DATA
+
+
 class StartupError(Exception):
     """A node cannot start (bad parameter or file); the message says which and why."""
 

@@ -24,8 +24,8 @@ from evorbc_ros.marker_geometry import rangefinder_rays, reading_colour
 from evorbc_ros.node_parameters import PARAMETERS, REMOVED
 from evorbc_ros.nodes.common import (
     RELIABLE,
-    SENSOR_DATA,
     StartupError,
+    input_qos,
     load_sensor_layout,
     logged_startup,
     now_seconds,
@@ -62,7 +62,9 @@ class LaserSensorNode(Node):
         self.warned_span = None  # the last scan geometry checked for unseen rangefinders
         self.markers = Markers(self, p["marker_frame"]) if p["markers"] else None
         self.diagnostics = DiagnosticsPublisher(self, p["diagnostics_period"], self.health)
-        self.sub = self.create_subscription(LaserScan, "scan", self.on_scan, SENSOR_DATA)
+        self.sub = self.create_subscription(
+            LaserScan, "scan", self.on_scan, input_qos(p["input_qos"])
+        )
 
     def on_scan(self, msg: LaserScan) -> None:
         """Publish the readings of one scan, or log why it was skipped."""

@@ -37,8 +37,8 @@ from evorbc_ros.node_parameters import PARAMETERS, REMOVED
 from evorbc_ros.nodes.common import (
     LATCHED,
     RELIABLE,
-    SENSOR_DATA,
     StartupError,
+    input_qos,
     load_sensor_layout,
     logged_startup,
     now_seconds,
@@ -84,7 +84,9 @@ class RadarSensorNode(Node):
             ),
             self.create_subscription(msg_type, "goal", self.on_goal, RELIABLE),
         ]
-        self.odom_sub = self.create_subscription(Odometry, "odom", self.on_odom, SENSOR_DATA)
+        self.odom_sub = self.create_subscription(
+            Odometry, "odom", self.on_odom, input_qos(p["input_qos"])
+        )
 
     def on_goal(self, msg) -> None:
         """Remember the goal (point, or a pose's position)."""
