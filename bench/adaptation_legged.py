@@ -9,10 +9,13 @@ time to the target without and with adaptation, the episodes won and lost, the l
 against the intact robot without adaptation and its share with adaptation (issue 42's
 target: at most half; intact: at most 2 points), falls, observations per adapted episode
 and reach per damaged leg or side. ``--out FILE.json`` writes the figures
-(docs/results/adaptation/).
+(docs/results/adaptation/). ``--expected settled`` compares observations with the legged
+settled outcomes (``evaluate --adapt-expected settled``: computed first, in PyBullet);
+``--generated 0`` runs the controller's own training mazes instead of generated ones.
 
     python bench/adaptation_legged.py [--robot hexapod] [--generated 10] [--starts 4]
-        [--sets none hexapod-leg-lost ...] [--out docs/results/adaptation/hexapod.json]
+        [--expected recorded] [--sets none hexapod-leg-lost ...]
+        [--out docs/results/adaptation/hexapod.json]
 """
 
 from __future__ import annotations
@@ -50,9 +53,16 @@ def reach(episodes) -> dict:
     }
 
 
-def measure(robot: str, name: str, generated: int, starts: int) -> dict:
-    """One set's figures (see the module docstring)."""
-    run = EvaluateRun(robot=robot, generated=generated, starts=starts, perturb=name, adapt=True)
+def measure(robot: str, name: str, generated: int, starts: int, expected: str = "recorded") -> dict:
+    """One set's figures (see the module docstring); ``generated`` 0: the training mazes."""
+    run = EvaluateRun(
+        robot=robot,
+        generated=generated or None,
+        starts=starts,
+        perturb=name,
+        adapt=True,
+        adapt_expected=expected,
+    )
     began = time.monotonic()
     runs = run_suites(run, Reporters([]))
     off, on = runs.suite.episodes, runs.adapted.episodes
@@ -76,6 +86,7 @@ def measure(robot: str, name: str, generated: int, starts: int) -> dict:
         "episodes_observed_pct": round(100 * float(np.mean(np.array(observations) > 0)), 1),
         "changed_episodes": sum(not np.array_equal(a, b) for a, b in paths),
         **({"per_part": per_part} if per_part else {}),
+        "expected": expected,
         "settings": asdict(runs.settings),
         "wall_s": round(time.monotonic() - began, 1),
     }
@@ -110,6 +121,7 @@ def main() -> None:
     parser.add_argument("--robot", default="hexapod", choices=sorted(DAMAGE))
     parser.add_argument("--generated", type=int, default=10)
     parser.add_argument("--starts", type=int, default=4)
+    parser.add_argument("--expected", default="recorded", choices=("recorded", "settled"))
     parser.add_argument("--sets", nargs="+", default=None, help="default: none and the damage")
     parser.add_argument("--out", help="write the figures as JSON")
     args = parser.parse_args()
@@ -118,16 +130,19 @@ def main() -> None:
         parser.error("--sets: the losses are against 'none', the intact robot")
     results = []
     for name in sets:
-        results.append(measure(args.robot, name, args.generated, args.starts))
+        results.append(measure(args.robot, name, args.generated, args.starts, args.expected))
         print(json.dumps(results[-1]), flush=True)
     with_losses(results)
     print_table(results)
     if args.out:
         out = {
             "command": f"bench/adaptation_legged.py --robot {args.robot} --generated "
-            f"{args.generated} --starts {args.starts}",
+            f"{args.generated} --starts {args.starts} --expected {args.expected}",
             "robot": args.robot,
-            "generated": {"count": args.generated, "seed": 21021},
+            "expected": args.expected,
+            "generated": {"count": args.generated, "seed": 21021}
+            if args.generated
+            else "the controller's training mazes",
             "starts_per_maze": args.starts,
             "seed": 0,
             "sets": results,
