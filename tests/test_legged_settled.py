@@ -13,7 +13,11 @@ import numpy as np
 import pytest
 from hexapod_helpers import tripod_repertoire
 
-from evorbc_ros.adaptation.settled import load_settled, settled_path
+from evorbc_ros.adaptation import outcome_table
+from evorbc_ros.adaptation.model import LEGGED_SETTINGS
+from evorbc_ros.adaptation.settled import load_settled, save_settled, settled_path
+from evorbc_ros.arbitration import Controller
+from evorbc_ros.defaults import default_arbitrator, default_repertoire
 from evorbc_ros.repertoire import Repertoire
 from evorbc_ros.robots.diff_drive import DiffDriveGeometry
 from offline_evolution.cli import main
@@ -102,3 +106,20 @@ def test_the_command_refuses_a_differential_drive_repertoire_in_one_line(tmp_pat
         "robots, not turtlebot3-burger"
     )
     assert not (tmp_path / "b.json").exists()
+
+
+def test_the_hexapod_node_adapts_against_a_settled_file_beside_its_repertoire(tmp_path):
+    # The arbitrator node's path (adaptation_expected: settled) has nothing wheeled in it:
+    # the shipped hexapod controller reads a file in the format the command writes and
+    # adapts against it with the legged settings. (The rows here are the recorded outcomes
+    # shifted, not computed: what is checked is the node's path, the computation above.)
+    rep = Repertoire.load(default_repertoire("hexapod"))
+    rows = outcome_table(rep.behaviour, rep.heading) + np.array([0.01, -0.02, 0.03])
+    path = tmp_path / "hexapod.settled.json"
+    save_settled(path, rows, rep)
+    controller = Controller(str(default_arbitrator("hexapod")))
+    read = controller.settled_outcomes(str(path))
+    np.testing.assert_array_equal(read.view(np.int64), rows.view(np.int64))
+    controller.enable_adaptation(expected=read)
+    assert controller.adaptation.settings == LEGGED_SETTINGS
+    np.testing.assert_array_equal(controller.adaptation.model.expected, rows)
