@@ -181,7 +181,8 @@ def main() -> None:
     if args.out:
         out = {
             "command": f"bench/adaptation_legged.py --robot {args.robot} --generated "
-            f"{args.generated} --starts {args.starts} --expected {' '.join(args.expected)}",
+            f"{args.generated} --starts {args.starts} --sets {' '.join(sets)} "
+            f"--expected {' '.join(args.expected)}",
             "robot": args.robot,
             "expected": args.expected,
             "generated": {"count": args.generated, "seed": 21021}
