@@ -9,10 +9,14 @@ time to the target without and with adaptation, the episodes won and lost, the l
 against the intact robot without adaptation and its share with adaptation (issue 42's
 target: at most half; intact: at most 2 points), falls, observations per adapted episode
 and reach per damaged leg or side. ``--out FILE.json`` writes the figures
-(docs/results/adaptation/).
+(docs/results/adaptation/). ``--expected settled`` compares observations with the legged
+settled outcomes (``evaluate --adapt-expected settled``: computed first, in PyBullet);
+several (``--expected recorded settled``) run the unadapted suite once and adapt against
+each; ``--generated 0`` runs the controller's own training mazes instead of generated ones.
 
     python bench/adaptation_legged.py [--robot hexapod] [--generated 10] [--starts 4]
-        [--sets none hexapod-leg-lost ...] [--out docs/results/adaptation/hexapod.json]
+        [--expected recorded settled] [--sets none hexapod-leg-lost ...]
+        [--out docs/results/adaptation/hexapod.json]
 """
 
 from __future__ import annotations
@@ -50,15 +54,61 @@ def reach(episodes) -> dict:
     }
 
 
-def measure(robot: str, name: str, generated: int, starts: int) -> dict:
-    """One set's figures (see the module docstring)."""
-    run = EvaluateRun(robot=robot, generated=generated, starts=starts, perturb=name, adapt=True)
+def measure(robot: str, name: str, generated: int, starts: int, expected=("recorded",), cache=None):
+    """One set's figures per ``expected`` (see the module docstring); ``generated`` 0: the
+    training mazes. The suite without adaptation runs once; ``cache``: expected outcomes by
+    repertoire fingerprint (the settled ones are computed once for every set)."""
+    run = EvaluateRun(
+        robot=robot,
+        generated=generated or None,
+        starts=starts,
+        perturb=name,
+        adapt=True,
+        adapt_expected=expected[0],
+    )
     began = time.monotonic()
     runs = run_suites(run, Reporters([]))
-    off, on = runs.suite.episodes, runs.adapted.episodes
     observations = runs.task.observations  # of the adapted suite, the last one run
+    results = [figures(name, runs, runs.adapted, observations, expected[0], began)]
+    for other in expected[1:]:
+        began = time.monotonic()
+        adapted, observations = adapted_again(runs, run, other, {} if cache is None else cache)
+        results.append(figures(name, runs, adapted, observations, other, began))
+    return results
+
+
+def adapted_again(runs, run: EvaluateRun, expected: str, cache: dict):
+    """The suite of ``runs`` adapting again, against ``expected``: ``(suite, observations)``.
+
+    As :func:`~offline_evolution.runs.evaluate.run_suites` adapts (the same task, starts,
+    worlds and settings), without running the unadapted suite again.
+    """
+    from offline_evolution.maze_task.adapting import expected_outcomes
+    from offline_evolution.maze_task.evaluation import evaluate_suite
+
+    task, rep, arb = runs.task, runs.repertoire, runs.arbitrator
+    key = (rep.fingerprint(), expected)
+    if key not in cache:
+        began = time.process_time()
+        cache[key] = expected_outcomes(rep, task.robot, expected)
+        print(f"expected {expected}: {time.process_time() - began:.1f} s of CPU", flush=True)
+    task.adapt(task.adapting_for(rep, runs.settings, cache[key]))
+    try:
+        controller = task.controller(arb.kind, rep, arb.mapping)
+        suite = evaluate_suite(
+            task, arb.network, controller, run.starts, run.seed, runs.perturbation
+        )
+    finally:
+        task.adapt(None)
+        task.close()
+    return suite, list(task.observations)
+
+
+def figures(name: str, runs, adapted, observations, expected: str, began: float) -> dict:
+    """The figures of one adapted suite against the unadapted one."""
+    off, on = runs.suite.episodes, adapted.episodes
     pairs = list(zip(off, on, strict=True))
-    paths = zip(runs.suite.choices, runs.adapted.choices, strict=True)
+    paths = zip(runs.suite.choices, adapted.choices, strict=True)
     per_part = {}
     for part in sorted({e.damaged_part for e in off if e.damaged_part}):
         idx = [k for k, e in enumerate(off) if e.damaged_part == part]
@@ -76,6 +126,7 @@ def measure(robot: str, name: str, generated: int, starts: int) -> dict:
         "episodes_observed_pct": round(100 * float(np.mean(np.array(observations) > 0)), 1),
         "changed_episodes": sum(not np.array_equal(a, b) for a, b in paths),
         **({"per_part": per_part} if per_part else {}),
+        "expected": expected,
         "settings": asdict(runs.settings),
         "wall_s": round(time.monotonic() - began, 1),
     }
@@ -98,7 +149,8 @@ def print_table(results: list[dict]) -> None:
     for r in results:
         share = f" ({100 * r['loss_share']:.0f} %)" if r["loss_share"] is not None else ""
         print(
-            f"| {r['set']} | {r['off']['reach_pct']:.1f} %, {r['off']['mean_time_s']:.1f} s "
+            f"| {r['set']} ({r['expected']}) "
+            f"| {r['off']['reach_pct']:.1f} %, {r['off']['mean_time_s']:.1f} s "
             f"| {r['on']['reach_pct']:.1f} %, {r['on']['mean_time_s']:.1f} s "
             f"| {r['won']} / {r['lost']} | {r['loss_off']:.1f} / {r['loss_on']:.1f}{share} "
             f"| {r['observations_per_episode']:.1f} |"
@@ -110,24 +162,32 @@ def main() -> None:
     parser.add_argument("--robot", default="hexapod", choices=sorted(DAMAGE))
     parser.add_argument("--generated", type=int, default=10)
     parser.add_argument("--starts", type=int, default=4)
+    parser.add_argument(
+        "--expected", nargs="+", default=["recorded"], choices=("recorded", "settled")
+    )
     parser.add_argument("--sets", nargs="+", default=None, help="default: none and the damage")
     parser.add_argument("--out", help="write the figures as JSON")
     args = parser.parse_args()
     sets = args.sets or ["none", *DAMAGE[args.robot]]
     if "none" not in sets:
         parser.error("--sets: the losses are against 'none', the intact robot")
-    results = []
+    results, cache = [], {}
     for name in sets:
-        results.append(measure(args.robot, name, args.generated, args.starts))
-        print(json.dumps(results[-1]), flush=True)
+        for r in measure(args.robot, name, args.generated, args.starts, args.expected, cache):
+            results.append(r)
+            print(json.dumps(r), flush=True)
     with_losses(results)
     print_table(results)
     if args.out:
         out = {
             "command": f"bench/adaptation_legged.py --robot {args.robot} --generated "
-            f"{args.generated} --starts {args.starts}",
+            f"{args.generated} --starts {args.starts} --sets {' '.join(sets)} "
+            f"--expected {' '.join(args.expected)}",
             "robot": args.robot,
-            "generated": {"count": args.generated, "seed": 21021},
+            "expected": args.expected,
+            "generated": {"count": args.generated, "seed": 21021}
+            if args.generated
+            else "the controller's training mazes",
             "starts_per_maze": args.starts,
             "seed": 0,
             "sets": results,

@@ -18,13 +18,20 @@ against the same over ``L`` cycles after a run's first (``--runs``): whether lon
 executions average the gait's oscillation out. For scale: the median distance from a
 primitive to its nearest other one in the same metric.
 
+With ``--settled-contexts C`` (> 0) it also computes the legged settled outcomes
+(:func:`sim_bridge.legged.settled.context_outcomes`, ``C`` seeded contexts on flat ground)
+of the primitives that ran long enough to be observed, and reports how far the same
+executions are from them, and how far each context's own reading is from their mean (the
+scatter of one observation on flat ground).
+
     python bench/legged_observations.py [--robot hexapod] [--starts 2] [--generated N]
-        [--perturb SET] [--out FILE.json]
+        [--perturb SET] [--settled-contexts 4] [--out FILE.json]
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 from dataclasses import asdict
 
@@ -57,7 +64,7 @@ def _nearest(recorded: np.ndarray, weight: np.ndarray) -> np.ndarray:
 
 
 def episode_figures(
-    path, choice, recorded, weight, horizon, dt, settings, family_settings, runs_of
+    path, choice, recorded, weight, horizon, dt, settings, family_settings, runs_of, settled=None
 ) -> dict:
     """One episode's figures (see the module docstring)."""
     choice = choice[: len(path) - 1]  # a robot that fell stops its trace early
@@ -66,6 +73,8 @@ def episode_figures(
     pos_tol, head_tol = online.tolerance
     held = agree = moving = 0
     cycle_err, run_err = [], {k: [] for k in runs_of}
+    # (error against recorded, against settled) of the executions whose primitive has both
+    paired = {k: [] for k in runs_of}
     last, k_run, run_start = None, 0, 0
     for t, ran in enumerate(choice):
         for a in (online, family):
@@ -94,6 +103,8 @@ def episode_figures(
                     a, b = path[run_start + 1], path[run_start + 1 + k]
                     m = _extended(a, b, k, dt, horizon)
                     run_err[k].append(_distance(m, recorded[ran], weight))
+                    if settled is not None and int(ran) in settled:
+                        paired[k].append((run_err[k][-1], _distance(m, settled[int(ran)], weight)))
     for a in (online, family):
         a.put_pose(round(len(choice) * dt * 1e9), *map(float, path[len(choice)]))
         a.before_choice()
@@ -109,7 +120,48 @@ def episode_figures(
         "family_observed": family.model.used,
         "cycle_err": cycle_err,
         "run_err": run_err,
+        "paired": paired,
     }
+
+
+def observed_settled(runs, rep, family, contexts: int, weight) -> tuple[dict, list]:
+    """Settled outcomes of the primitives run long enough to be observed, and their scatter.
+
+    Returns ``({primitive: (3,) settled outcome}, [each context's distance from the mean])``.
+    """
+    from sim_bridge.legged.settled import context_outcomes
+
+    need = 1 + family.settle_cycles + family.window - 1
+    observed = set()
+    for c in runs.suite.choices:
+        edges = np.flatnonzero(np.r_[True, c[1:] != c[:-1], True])
+        for a, b in itertools.pairwise(edges):
+            if b - a >= need and c[a] >= 0:  # not NO_PRIMITIVE, nor NOT_RUN padding
+                observed.add(int(c[a]))
+    index = sorted(observed)
+    samples = context_outcomes(
+        runs.task.robot, rep.genes, rep.eval_time, family.settle_cycles, family.window,
+        contexts, indices=index,
+    )  # fmt: skip
+    mean = samples.mean(axis=1)
+    scatter = np.sqrt((((samples - mean[:, None]) * weight) ** 2).sum(axis=-1)).ravel()
+    return dict(zip(index, mean, strict=True)), scatter.tolist()
+
+
+def settled_figures(eps, runs_of, contexts: int, scatter, q) -> dict:
+    """The same executions against the recorded and the settled outcomes (paired)."""
+    out = {"contexts": contexts, "context_scatter_p50_p90": q(scatter), "runs": {}}
+    for k in runs_of:
+        pairs = np.array([p for e in eps for p in e["paired"][k]]).reshape(-1, 2)
+        out["runs"][k] = {
+            "n": len(pairs),
+            "recorded_p50_p90": q(pairs[:, 0]),
+            "settled_p50_p90": q(pairs[:, 1]),
+            "settled_closer_pct": round(100 * float(np.mean(pairs[:, 1] < pairs[:, 0])), 1)
+            if len(pairs)
+            else None,
+        }
+    return out
 
 
 def main() -> None:
@@ -119,6 +171,7 @@ def main() -> None:
     parser.add_argument("--generated", type=int, default=None)
     parser.add_argument("--perturb", default="none", help="a perturbation or damage set")
     parser.add_argument("--runs", type=int, nargs="+", default=[1, 2, 5, 10, 20])
+    parser.add_argument("--settled-contexts", type=int, default=0, help="0: no settled outcomes")
     parser.add_argument("--out", help="write the figures as JSON")
     args = parser.parse_args()
     run = EvaluateRun(
@@ -131,8 +184,13 @@ def main() -> None:
     settings = AdaptationSettings()
     conf, _ = settings_arrays(recorded, rep.eval_time, settings)
     family = settings_for(robot_family(args.robot))
+    settled, scatter = None, None
+    if args.settled_contexts > 0:
+        settled, scatter = observed_settled(runs, rep, family, args.settled_contexts, weight)
     eps = [
-        episode_figures(p, c, recorded, weight, rep.eval_time, dt, settings, family, args.runs)
+        episode_figures(
+            p, c, recorded, weight, rep.eval_time, dt, settings, family, args.runs, settled
+        )
         for p, c in zip(runs.suite.paths, runs.suite.choices, strict=True)
     ]
     cycles = sum(e["cycles"] for e in eps)
@@ -179,6 +237,8 @@ def main() -> None:
             for k in args.runs
         },
     }
+    if settled is not None:
+        out["settled"] = settled_figures(eps, args.runs, args.settled_contexts, scatter, q)
     print(json.dumps(out, indent=1))
     if args.out:
         from evorbc_ros.atomic_io import atomic_write_text

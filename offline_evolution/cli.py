@@ -3,7 +3,7 @@
 Subcommands:
     repertoire   generate a MAP-Elites repertoire of locomotion primitives
     export-csv   convert a repertoire file to CSV
-    settled      a wheeled repertoire's settled outcomes, for the arbitrator node's adaptation
+    settled      a 4WS or legged repertoire's settled outcomes, for the node's adaptation
     arbitrator   evolve an EvoRBC arbitrator (NEAT) for a repertoire
     standard     evolve a standard-NEAT controller (the baseline)
     replay       run a controller in the mazes and report

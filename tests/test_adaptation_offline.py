@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+from hexapod_helpers import tripod_repertoire
 
 from evorbc_ros.adaptation import AdaptationSettings
 from evorbc_ros.arbitrator import ArbitratorFile
@@ -125,12 +126,23 @@ def test_evaluate_adapt_reports_each_episode_with_and_without(tmp_path, capsys):
     assert "adaptation" not in json.loads(capsys.readouterr().out)  # only with --adapt
 
 
-def test_evaluate_adapt_refuses_what_cannot_adapt_in_one_line(capsys):
-    # Legged robots adapt (tests/test_legged_adaptation.py), against the recorded outcomes
-    # only: the settled ones are the 4WS model's.
-    args = ["evaluate", "--robot", "hexapod", "--starts", "1", "--adapt"]
-    assert main([*args, "--adapt-expected", "settled"]) == 1
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and err.endswith(
-        "--adapt-expected settled: adaptation expected settled: only for 4WS robots, not hexapod"
+def test_evaluate_adapts_a_legged_robot_against_its_settled_outcomes(tmp_path, capsys):
+    # Legged robots adapt (tests/test_legged_adaptation.py) against the recorded outcomes
+    # or their settled ones, computed in PyBullet first (tests/test_legged_settled.py): the
+    # shipped hexapod controller with six tripod gaits (a mismatch, waived), 3 s episodes.
+    rep = tmp_path / "tripods.repertoire.json"
+    tripod_repertoire().save(rep)
+    task = tmp_path / "task.yaml"
+    task.write_text(
+        "mazes: [hexapod]\nepisode_time: 3.0\nsamples_per_maze: 1\nsensors: sensors/hexapod.yaml\n"
     )
+    out = tmp_path / "report.json"
+    args = ["evaluate", "--robot", "hexapod", "--repertoire", str(rep), "--allow-mismatch",
+            "--task", str(task), "--mazes", "hexapod", "--starts", "1", "--adapt",
+            "--adapt-expected", "settled", "--out", str(out)]  # fmt: skip
+    assert main(args) == 0
+    assert "with adaptation (expected: settled):" in capsys.readouterr().out
+    report = json.loads(out.read_text())
+    assert report["adaptation"]["expected"] == "settled"
+    assert report["adaptation"]["settings"]["steady"] == "held"  # the legged settings
+    assert len(report["adaptation"]["episodes"]) == len(report["episodes"]) == 1

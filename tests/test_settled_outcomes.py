@@ -39,17 +39,6 @@ def test_the_shipped_file_is_what_the_command_writes_and_the_model_computes(tmp_
     assert settled_path("d/x.json").as_posix() == "d/x.settled.json"
 
 
-def test_the_command_refuses_a_legged_repertoire_in_one_line(tmp_path, capsys):
-    rep = default_repertoire("hexapod")
-    assert main(["settled", str(rep), "--out", str(tmp_path / "h.json")]) == 1
-    err = capsys.readouterr().err.strip()
-    assert err == (
-        f"evorbc-evolve: error: {rep}: adaptation expected settled: only for 4WS robots, "
-        "not hexapod"
-    )
-    assert not (tmp_path / "h.json").exists()
-
-
 def _edited(tmp_path, edit):
     data = json.loads(SHIPPED.read_text())
     edit(data)

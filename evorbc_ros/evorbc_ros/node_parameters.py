@@ -201,7 +201,8 @@ PARAMETERS: dict[str, tuple[ParamSpec, ...]] = {
             "recorded",
             "what adaptation compares an observation with: recorded (the repertoire's "
             "outcomes, measured from rest) or settled (what each primitive does once its "
-            "actuators hold its command, from settled_outcomes); a change while adapting "
+            "actuators hold its command, or a legged robot's whole execution after other "
+            "primitives, from settled_outcomes); a change while adapting "
             "starts again from the prior",
             choices=("recorded", "settled"),
             live=True,

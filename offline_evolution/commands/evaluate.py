@@ -92,7 +92,8 @@ def add_parsers(sub) -> None:
         choices=EXPECTED,
         default=EvaluateRun.adapt_expected,
         help="what an observation is compared with: the recorded outcomes, as the "
-        "arbitrator node does (default), or the 4WS model's settled ones",
+        "arbitrator node does (default), or the settled ones (4WS: the motion model's; "
+        "legged: whole executions after other primitives, in PyBullet, computed first)",
     )
     add_flag(p, WAIVER)
     p.set_defaults(func=cmd_evaluate)

@@ -1,8 +1,9 @@
-"""``evorbc-evolve settled``: a wheeled repertoire's settled outcomes, for the onboard node.
+"""``evorbc-evolve settled``: a repertoire's settled outcomes, for the onboard node.
 
 Onboard adaptation compares observations with what each primitive does once its actuators
-hold its command (docs/design/adaptation.md, "What an observation is compared with"). Only
-the robot's motion model can compute that, and the arbitrator node must not import it, so
+hold its command, or for a legged robot what a whole execution after other primitives does
+(docs/design/adaptation.md, "What an observation is compared with"). Only the robot's
+simulation can compute that, and the arbitrator node must not import it, so
 this command computes the outcomes offline, exactly as ``evaluate --adapt-expected
 settled`` does, and writes them beside the repertoire for the node to read
 (:mod:`offline_evolution.runs.settled`, :mod:`evorbc_ros.adaptation.settled`).
@@ -22,10 +23,12 @@ def add_parsers(sub) -> None:
     """Register ``settled``."""
     p = sub.add_parser(
         "settled",
-        help="a wheeled repertoire's settled outcomes, for the arbitrator node's adaptation",
+        help="a 4WS or legged repertoire's settled outcomes, for the arbitrator node's adaptation",
         description="Compute what each primitive of a 4WS repertoire does once its actuators "
-        "hold its command (the outcomes evaluate --adapt-expected settled compares "
-        "observations with) and write them for the arbitrator node's adaptation_expected "
+        "hold its command, or of a legged repertoire what a whole execution after other "
+        "primitives observes (PyBullet, seeded; about half a minute for the shipped "
+        "hexapod's), the outcomes evaluate --adapt-expected settled compares "
+        "observations with, and write them for the arbitrator node's adaptation_expected "
         "settled (docs/design/adaptation.md).",
     )
     p.add_argument("repertoire", metavar="REPERTOIRE", help="repertoire file (JSON)")

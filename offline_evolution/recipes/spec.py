@@ -14,7 +14,7 @@ A recipe names its steps in order. Each step runs one kind of job and writes one
   (``evorbc-evolve robot-from-urdf``); its ``out`` is ``NAME-model.yaml``;
 * ``design-gait``: the gait design search (``evorbc-evolve design-gait``) over the
   settings an earlier step wrote (``settings_step``), at a ``budget`` with a ``seed``;
-* ``settled``: the settled outcomes of a 4WS ``repertoire`` an earlier step wrote (or
+* ``settled``: the settled outcomes of a 4WS or legged ``repertoire`` an earlier step wrote (or
   ``repertoire_file``), for the arbitrator node's adaptation (``evorbc-evolve settled``).
 
 A repertoire step's robot is a registered ``robot``, a robot settings file

@@ -194,7 +194,7 @@ def _adaptation(run: EvaluateRun, arb, task, repertoire):
 
     Raises:
         UserError: a standard controller, a robot whose episodes do not adapt, or
-            ``--adapt-expected settled`` for a robot that is not 4WS.
+            ``--adapt-expected settled`` for a robot that is neither 4WS nor legged.
     """
     if not run.adapt:
         return None
