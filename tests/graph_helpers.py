@@ -52,6 +52,12 @@ class GraphRun:
         self.procs = {}
         for name, module in NODES.items():
             params = {"use_sim_time": True}
+            if name in ("laser_sensor", "radar_sensor", "arbitrator") and mode == "lockstep":
+                # As sim_bridge.graph sets it: a best-effort reader drops what reaches it
+                # before its side of the match completes (in a loaded CI run an adapting
+                # arbitrator chose as if it had seen no odometry for ~40 cycles;
+                # docs/design/ros-graph.md, "Messages and QoS").
+                params["input_qos"] = "reliable"
             if name in ("laser_sensor", "radar_sensor"):
                 params["sensor_layout"] = self.arb
             if name == "arbitrator":
