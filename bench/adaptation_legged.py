@@ -13,9 +13,12 @@ and reach per damaged leg or side. ``--out FILE.json`` writes the figures
 settled outcomes (``evaluate --adapt-expected settled``: computed first, in PyBullet);
 several (``--expected recorded settled``) run the unadapted suite once and adapt against
 each; ``--generated 0`` runs the controller's own training mazes instead of generated ones.
+``--setting KEY=VALUE`` (repeatable) overrides a field of the robot family's default
+:class:`~evorbc_ros.adaptation.AdaptationSettings` (``noise=1.0``, ``average=8``), to compare
+settings on the training mazes before one is made the default.
 
     python bench/adaptation_legged.py [--robot hexapod] [--generated 10] [--starts 4]
-        [--expected recorded settled] [--sets none hexapod-leg-lost ...]
+        [--expected recorded settled] [--sets none hexapod-leg-lost ...] [--setting noise=1]
         [--out docs/results/adaptation/hexapod.json]
 """
 
@@ -157,6 +160,33 @@ def print_table(results: list[dict]) -> None:
         )
 
 
+def override_settings(pairs: list[str]) -> dict:
+    """Make ``evorbc_ros.adaptation.settings_for`` give the family default with ``pairs``.
+
+    What ``evaluate --adapt`` adapts with is the node's default for the robot's family
+    (:func:`offline_evolution.maze_task.adapting.task_adapting`, called in this process),
+    so replacing the function here changes the suites measured and nothing else.
+
+    Returns:
+        The overridden fields, typed as the settings' (for the JSON record).
+    """
+    import dataclasses
+
+    import evorbc_ros.adaptation as adaptation
+
+    fields = {f.name: f.type for f in dataclasses.fields(adaptation.AdaptationSettings)}
+    changes = {}
+    for pair in pairs:
+        key, _, value = pair.partition("=")
+        if key not in fields:
+            raise SystemExit(f"--setting {pair}: no such field (one of {', '.join(fields)})")
+        kind = {"int": int, "float": float}.get(str(fields[key]), str)
+        changes[key] = kind(value)
+    default = adaptation.settings_for
+    adaptation.settings_for = lambda family: dataclasses.replace(default(family), **changes)
+    return changes
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robot", default="hexapod", choices=sorted(DAMAGE))
@@ -167,7 +197,9 @@ def main() -> None:
     )
     parser.add_argument("--sets", nargs="+", default=None, help="default: none and the damage")
     parser.add_argument("--out", help="write the figures as JSON")
+    parser.add_argument("--setting", action="append", default=[], metavar="KEY=VALUE")
     args = parser.parse_args()
+    changes = override_settings(args.setting)
     sets = args.sets or ["none", *DAMAGE[args.robot]]
     if "none" not in sets:
         parser.error("--sets: the losses are against 'none', the intact robot")
@@ -182,7 +214,8 @@ def main() -> None:
         out = {
             "command": f"bench/adaptation_legged.py --robot {args.robot} --generated "
             f"{args.generated} --starts {args.starts} --sets {' '.join(sets)} "
-            f"--expected {' '.join(args.expected)}",
+            f"--expected {' '.join(args.expected)}"
+            + "".join(f" --setting {pair}" for pair in args.setting),
             "robot": args.robot,
             "expected": args.expected,
             "generated": {"count": args.generated, "seed": 21021}
@@ -190,6 +223,7 @@ def main() -> None:
             else "the controller's training mazes",
             "starts_per_maze": args.starts,
             "seed": 0,
+            "settings_changed": changes,
             "sets": results,
         }
         atomic_write_text(args.out, json.dumps(out, indent=1) + "\n")

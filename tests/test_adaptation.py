@@ -98,6 +98,49 @@ def test_compiled_functions_give_the_same_bits(recorded):
     assert plain.nearest_outcome(7) == jitted.nearest_outcome(7)
 
 
+def test_repeated_observations_are_averaged_with_the_noise_over_their_number(recorded):
+    """``average`` > 1: a slot holds the mean of its primitive's readings, noise / hits."""
+    rng = np.random.default_rng(8)
+    i, j = 11, 40
+    readings = [recorded[i] + rng.normal(0.0, 0.02, 3) for _ in range(6)]
+    for average, kept in ((4, 4), (1, 1)):
+        model = OutcomeModel(recorded, AdaptationSettings(average=average))
+        for r in readings[:3]:
+            model.observe(i, r)
+        model.observe(j, recorded[j] + 0.01)
+        s = int(np.flatnonzero(model.slots == i)[0])
+        want = np.mean(readings[3 - min(3, kept) : 3], axis=0) - recorded[i]
+        np.testing.assert_allclose(model.residual[s], want, atol=1e-15)
+        assert model.counts[gp.HITS + s] == min(3, kept)
+        # the GP sees the slot's noise over its count
+        m = model.used
+        kzz = model.kzx[:m][:, model.slots[:m]] + 0.05 * np.diag(
+            1.0 / model.counts[gp.HITS : gp.HITS + m]
+        )
+        want = recorded + (np.linalg.solve(kzz, model.residual[:m]).T @ model.kzx[:m]).T
+        np.testing.assert_allclose(model.corrected, want, atol=1e-12)
+    # past ``average`` the mean is exponential (weight 1/average on the newest)
+    model = OutcomeModel(recorded, AdaptationSettings(average=2))
+    for r in readings:
+        model.observe(i, r)
+    want = readings[0] - recorded[i]
+    for r in readings[1:]:
+        want = want + (r - recorded[i] - want) / 2
+    np.testing.assert_allclose(model.residual[0], want, atol=1e-15)
+    # a reset forgets the counts and keeps the setting; a slot taken anew starts at 1
+    model.reset()
+    assert model.counts[gp.AVERAGE] == 2 and not model.counts[gp.HITS :].any()
+    model.observe(i, readings[5])
+    np.testing.assert_array_equal(model.residual[0], readings[5] - recorded[i])
+    # plain and compiled give the same bits
+    jitted = OutcomeModel(recorded, AdaptationSettings(average=3), functions=gp.compiled(nb.njit))
+    plain = OutcomeModel(recorded, AdaptationSettings(average=3))
+    for k, r in enumerate(readings * 2):
+        for m in (plain, jitted):
+            m.observe((i, j, i, 7)[k % 4], r)
+    assert np.array_equal(plain.corrected, jitted.corrected)
+
+
 def test_turning_twenty_percent_less_is_learned(recorded):
     """Observed primitives teach the model about the others, and the choices improve."""
     rng = np.random.default_rng(6)
@@ -186,6 +229,8 @@ def test_settings_are_checked():
         AdaptationSettings(noise=0.0)
     with pytest.raises(ValueError, match="adaptation match must be one of outcome, point"):
         AdaptationSettings(match="nearest")
+    with pytest.raises(ValueError, match="adaptation average must be between 1 and 1000"):
+        AdaptationSettings(average=0)
 
 
 def test_remainder_is_math_remainder_plain_and_compiled():

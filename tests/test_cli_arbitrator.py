@@ -49,13 +49,18 @@ def test_arbitrator_writes_file_curve_and_summary(evolved, tmp_path):
     assert not (tmp_path / "a.json.checkpoint.json").exists()
 
 
+def small_run(tmp_path, repertoire, neat_file, task_file, generations: int) -> list:
+    """``arbitrator`` arguments of a quiet small run (the repertoire saved in tmp_path)."""
+    rep = tmp_path / "r.json"
+    repertoire.save(rep)
+    argv = ["arbitrator", "--repertoire", rep, "--generations", generations, "--seed", 2]
+    return [*argv, "--quiet", "--neat-config", neat_file, "--task", task_file]
+
+
 def test_the_population_and_the_post_selection_size_are_options(
     tmp_path, capsys, small_repertoire, small_neat_file, small_task_file
 ):
-    rep = tmp_path / "r.json"
-    small_repertoire.save(rep)
-    argv = ["arbitrator", "--repertoire", rep, "--generations", 2, "--seed", 2, "--quiet"]
-    argv += ["--neat-config", small_neat_file, "--task", small_task_file]
+    argv = small_run(tmp_path, small_repertoire, small_neat_file, small_task_file, 2)
     out = tmp_path / "a.json"
     options = ["--population", 12, "--hall-of-fame", 1, "--post-samples", 1]
     code, _, err = run(capsys, *argv, *options, "--out", out)
@@ -308,3 +313,22 @@ def test_a_kept_checkpoint_continues_to_more_generations(
     assert strip == [
         {k: v for k, v in h.items() if "seconds" not in k} for h in straight.evolution["history"]
     ]
+
+
+def test_the_episode_time_is_an_option_recorded_with_the_controller(
+    tmp_path, capsys, small_repertoire, small_neat_file, small_task_file
+):
+    argv = small_run(tmp_path, small_repertoire, small_neat_file, small_task_file, 1)
+    argv += ["--population", 12, "--hall-of-fame", 1, "--post-samples", 1]
+    code, _, err = run(capsys, *argv, "--episode-time", 3.5, "--out", tmp_path / "a.json")
+    assert code == 0, err
+    task = ArbitratorFile.load(tmp_path / "a.json").evolution["task"]
+    assert task["episode_time"] == 3.5  # the task file says otherwise
+    # replay reads it: its episodes last 3.5 s at most
+    code, stdout, err = run(capsys, "replay", "--arbitrator", tmp_path / "a.json", "--json")
+    assert code == 0, err
+    assert all(m["time"] <= 3.5 for m in json.loads(stdout)["mazes"])
+    # Not a whole number of 0.1 s cycles: refused in one line.
+    code, _, err = run(capsys, *argv, "--episode-time", 3.55, "--out", tmp_path / "b.json")
+    assert code != 0 and len(err.strip().splitlines()) == 1, err
+    assert "--episode-time 3.55: episode_time must be a positive multiple" in err

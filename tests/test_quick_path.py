@@ -15,6 +15,7 @@ import pytest
 from evorbc_ros.robots import registry
 from evorbc_ros.robots.settings_robots import PATH_VARIABLE
 from offline_evolution.cli import main
+from offline_evolution.gait_design.maze_needs import fitted_episode_time
 from offline_evolution.recipes.digest import content_sha256
 from offline_evolution.recipes.profiles import write_profile_recipe
 from offline_evolution.recipes.spec import load_recipe
@@ -46,6 +47,8 @@ def test_the_a1_urdf_to_a_controller(tmp_path, capsys):
     controller = json.loads((tmp_path / "a1-urdf.arbitrator.json").read_text())
     assert controller["robot"] == "a1-urdf"
     assert "design_search" in (tmp_path / "a1-urdf-designed.yaml").read_text()
+    declared = (tmp_path / "robots" / "a1-urdf.yaml").read_text()
+    assert "episode_time: " in declared and "# s, " in declared  # fitted, and says how
     rep = json.loads((tmp_path / "a1-urdf.repertoire.json").read_text())
     assert rep["robot"] == "a1-urdf"
     # Each stage's time is recorded (bench/bench_profiles.py reports it).
@@ -89,6 +92,22 @@ def test_the_profiles_budgets_reach_the_recipe(tmp_path):
         6000,
         30,
     )
+
+
+def test_a_urdf_robots_episode_is_as_long_as_its_designed_gait_needs(tmp_path):
+    # The Laikago's quick design: random gaits' p90 0.103 m/s, a 9.47 m maze path asked
+    # 0.47 m/s of a 30 s episode; 2 x 0.103 m/s covers it in 2/3 of 69 s.
+    laikago = {"maze": {"episode_time": 30.0, "path": 9.4699}, "measures": {"speed": 0.1028}}
+    seconds, why = fitted_episode_time(laikago)
+    assert seconds == 70.0 and "9.47 m of maze path at 0.21 m/s" in why
+    fast = {"maze": {"episode_time": 30.0, "path": 8.67}, "measures": {"speed": 0.33}}
+    assert fitted_episode_time(fast)[0] == 30.0  # its gait covers its mazes: unchanged
+    assert fitted_episode_time(None) == (30.0, "the A1's")
+    # The profile's arbitrator step takes the robot's episode time for a URDF robot only.
+    path = write_profile_recipe("pybullet_data:a1/a1.urdf", "quick", tmp_path, 1)
+    assert load_recipe(path).step("arbitrator").robot_episode_time
+    path = write_profile_recipe(str(HUSKY), "quick", tmp_path, 1)
+    assert not load_recipe(path).step("arbitrator").robot_episode_time
 
 
 @pytest.mark.parametrize(

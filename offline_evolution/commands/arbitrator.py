@@ -53,6 +53,13 @@ def _common_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--neat-config", metavar="FILE.ini", help="NEAT settings (neat-python format)")
     add_task(p, "the one the run settings name")
     p.add_argument(
+        "--episode-time",
+        type=float,
+        metavar="S",
+        help="s, each training and post-selection episode's length, in place of the task's "
+        "episode_time (recorded with the controller, as evaluate reads it)",
+    )
+    p.add_argument(
         "--plot", metavar="FILE.png", help="fitness-curve picture (default: OUT with .fitness.png)"
     )
     add_resume_options(p, CHECKPOINT_SUFFIX, "generations")

@@ -18,10 +18,16 @@ start is ``path_limit``. From that spec:
 The robot's maze and episode time are its registration's when its settings name a
 registered robot, otherwise those ``robot-from-urdf`` declares for every robot it makes
 (:data:`DEFAULT_MAZE`, :data:`DEFAULT_EPISODE_TIME`).
+
+A design slower than its mazes ask gets a longer episode instead of mazes it cannot
+cross in time (:func:`fitted_episode_time`): its maze keeps its size and layout, the
+episode grows to what its speed needs, as the slow 4WS robot's 120 s episodes do for its
+0.2 m/s (docs/your-robot.md, "Episode time from the design").
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -35,6 +41,10 @@ DEFAULT_MAZE = "a1"
 DEFAULT_EPISODE_TIME = 30.0
 #: Share of an episode the generator allows for the longest path at top speed.
 PATH_SHARE = 2.0 / 3.0
+#: s: a fitted episode time is a whole number of these (30, 70, 90 s ...).
+EPISODE_STEP = 5.0
+#: s: the longest fitted episode, the 4WS robots' (a slower gait is not made to fit).
+MAX_FITTED_EPISODE = 120.0
 
 
 @dataclass(frozen=True)
@@ -96,4 +106,44 @@ def maze_needs(settings: LeggedRobotSettings) -> MazeNeeds:
         path=round(spec.path_limit, 4),
         room=round(spec.narrow_gap[0], 4),
         wall_thickness=spec.wall_thickness,
+    )
+
+
+def fitted_episode_time(record: dict | None) -> tuple[float, str]:
+    """The episode time (s) of a robot whose gait design search left ``record``.
+
+    ``record`` is a designed settings file's ``design_search`` mapping (its ``maze`` and
+    ``measures``); None (no search): :data:`DEFAULT_EPISODE_TIME`. A design whose estimated
+    top speed, ``SPREAD`` x the 90th percentile of its random gaits' speed (the design
+    objective's own estimate, objective.py), covers the maze's longest path within
+    :data:`PATH_SHARE` of the searched episode keeps that episode; a slower one gets the
+    time that speed needs, rounded up to :data:`EPISODE_STEP`, at most
+    :data:`MAX_FITTED_EPISODE` (a gait slower than that is too slow for its mazes, and
+    the note says so).
+
+    Returns:
+        ``(seconds, why)``: ``why`` says how it was found (a settings-file comment).
+    """
+    from offline_evolution.gait_design.objective import SPREAD
+
+    if not record:
+        return DEFAULT_EPISODE_TIME, "the A1's"
+    maze, measures = record.get("maze") or {}, record.get("measures") or {}
+    searched = float(maze.get("episode_time", DEFAULT_EPISODE_TIME))
+    path, speed = float(maze.get("path", 0.0)), SPREAD * float(measures.get("speed", 0.0))
+    if path <= 0.0 or speed <= 0.0:
+        return searched, "the design search's"
+    needed = path / (PATH_SHARE * speed)
+    if needed <= searched:
+        return searched, f"the design search's: its gait's {speed:.2f} m/s covers its mazes"
+    seconds = EPISODE_STEP * math.ceil(needed / EPISODE_STEP - 1e-9)
+    if seconds > MAX_FITTED_EPISODE:
+        return MAX_FITTED_EPISODE, (
+            f"at most {MAX_FITTED_EPISODE:g} s: its gait's {speed:.2f} m/s would need "
+            f"{seconds:g} s for {path:.2f} m of maze path; too slow for its mazes"
+        )
+    return seconds, (
+        f"{path:.2f} m of maze path at {speed:.2f} m/s ({SPREAD:g} x its random gaits' "
+        f"p90) in {PATH_SHARE:.2f} of the episode; the design search's {searched:g} s asked "
+        f"{path / (PATH_SHARE * searched):.2f} m/s"
     )

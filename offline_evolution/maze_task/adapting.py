@@ -94,6 +94,7 @@ def adapting(
         np.ascontiguousarray(model.weight, dtype=np.float64),
         float(settings.noise),
         int(settings.capacity),
+        int(settings.average),
         float(dt),
     )
 

@@ -53,6 +53,7 @@ _ADAPT = adaptation_cycles.compiled(nb.njit)
 _put_pose = _ADAPT["put_pose"]
 _before_choice = _ADAPT["before_choice"]
 _after_choice = _ADAPT["after_choice"]
+_new_counts = _ADAPT["new_counts"]
 _adapted_choice = _ADAPT["choose"]
 _quaternion_yaw = nb.njit(cache=True)(quaternion_yaw)
 _planar_quaternion = nb.njit(cache=True)(planar_quaternion)
@@ -107,6 +108,7 @@ class Adapting(NamedTuple):
         weight: ``(3,)`` 1 / each outcome dimension's extent (1/m, 1/m, 1/rad).
         noise: the model's noise variance over the prior's.
         capacity: the ring's ``K``.
+        average: the most observations a slot averages.
         dt: s, the control period: cycle ``t``'s pose is stamped ``round(t dt 1e9)`` ns,
             as the bridge stamps its odometry.
     """
@@ -119,6 +121,7 @@ class Adapting(NamedTuple):
     weight: np.ndarray
     noise: float
     capacity: int
+    average: int
     dt: float
 
 
@@ -320,7 +323,7 @@ def _new_model(adapt):
     model = (adapt.features, adapt.recorded, adapt.expected, np.zeros((k, n)),
              np.full(k, -1, dtype=np.int64), np.zeros((k, 3)), np.zeros((k, k)),
              np.zeros((k, 3)), np.zeros((3, n)), adapt.recorded.copy(),
-             np.zeros(3, dtype=np.int64), adapt.noise)  # fmt: skip
+             _new_counts(k, adapt.average), adapt.noise)  # fmt: skip
     return ints, np.zeros(adaptation_cycles.N_FLOATS), model
 
 

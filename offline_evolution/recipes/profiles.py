@@ -7,7 +7,8 @@ a recipe (``recipe.yaml``) and the run and task settings of its arbitrator step
 * SOURCE a URDF (``.urdf`` or ``pybullet_data:PATH``): ``robot-from-urdf``,
   ``design-gait`` at the profile's budget, the repertoire with the profile's ``legged``
   budget, the arbitrator from the A1's run and task settings (which the derived robot
-  uses) with the profile's ``legged`` overrides and generated-maze training;
+  uses) with the profile's ``legged`` overrides and generated-maze training, its
+  episodes as long as the designed gait needs (``robot_episode_time``);
 * SOURCE a robot settings file (docs/your-robot.md): the repertoire and arbitrator of its
   own settings, with the profile's ``wheeled`` (diff_drive, four_ws) or ``legged`` ones.
 
@@ -140,6 +141,9 @@ def write_profile_recipe(
             "repertoire": "repertoire",
             "settings": str(run),
             "seed": seed,
+            # A URDF robot's episode is as long as its designed gait needs
+            # (gait_design/maze_needs.py, fitted_episode_time), not the A1's task's 30 s.
+            **({"robot_episode_time": True} if robot == {"robot_step": "design"} else {}),
             "out": f"{name}.arbitrator.json",
         }
     )

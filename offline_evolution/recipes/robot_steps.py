@@ -3,10 +3,12 @@
 The registration gives a recipe's own robots to its repertoire and arbitrator steps.
 
 A legged robot made by a recipe is declared in ``OUT/robots/NAME.yaml`` (a robot
-settings file naming the last model an earlier step wrote), and ``OUT/robots`` and the
-folders of the recipe's ``robot_file`` robots are put first on this process's
-``$EVORBC_ROBOT_PATH`` (docs/your-robot.md, "The quick path"), so that the runs, their
-worker processes and the files they write find the robot by name as any user's.
+settings file naming the last model an earlier step wrote, with the episode time its
+gait design needs: :func:`~offline_evolution.gait_design.maze_needs.fitted_episode_time`),
+and ``OUT/robots`` and the folders of the recipe's ``robot_file`` robots are put first on
+this process's ``$EVORBC_ROBOT_PATH`` (docs/your-robot.md, "The quick path"), so that the
+runs, their worker processes and the files they write find the robot by name as any
+user's.
 """
 
 from __future__ import annotations
@@ -61,6 +63,7 @@ def register_robots(recipe: Recipe, out: Path) -> None:
     """Declare the recipe's robots made so far and put their folders on the robot path."""
     from evorbc_ros.robots import registry
     from evorbc_ros.robots.settings_robots import PATH_VARIABLE
+    from offline_evolution.gait_design.maze_needs import fitted_episode_time
     from sim_bridge.legged.urdf_settings import declaration_text
 
     folders = []
@@ -73,7 +76,9 @@ def register_robots(recipe: Recipe, out: Path) -> None:
             name = urdf_step_of(recipe, step.robot_step).name
             model = recipe.step(step.robot_step).out
             path = out / ROBOTS_FOLDER / f"{name}.yaml"
-            text = declaration_text(name, f"../{model}", f"{name}, made by {recipe.recipe}")
+            seconds, why = fitted_episode_time(_design_record(out / model))
+            description = f"{name}, made by {recipe.recipe}"
+            text = declaration_text(name, f"../{model}", description, seconds, why)
             if not path.is_file() or path.read_text() != text:
                 path.parent.mkdir(exist_ok=True)
                 atomic_write_text(path, text)
@@ -83,6 +88,14 @@ def register_robots(recipe: Recipe, out: Path) -> None:
     held = [f for f in os.environ.get(PATH_VARIABLE, "").split(os.pathsep) if f]
     os.environ[PATH_VARIABLE] = os.pathsep.join(dict.fromkeys(folders + held))
     registry.reset()  # the registry read the robot path before; read it again
+
+
+def _design_record(model: Path) -> dict | None:
+    """The ``design_search`` record of a legged settings file (None: no search made it)."""
+    from evorbc_ros.config import load_yaml_mapping
+
+    record = load_yaml_mapping(model).get("design_search")
+    return record if isinstance(record, dict) else None
 
 
 def run_robot_from_urdf(step: RobotFromUrdfStep, out: Path, say: Callable[[str], None]) -> None:

@@ -260,12 +260,20 @@ def _arbitrator_run(recipe: Recipe, step: ArbitratorStep, out: Path, budget: str
     init = step.init_from_file or (
         str(out / recipe.step(step.init_from).out) if step.init_from else None
     )
+    repertoire = step.repertoire_file or str(out / recipe.step(step.repertoire).out)
+    episode_time = None
+    if step.robot_episode_time and budget != "small":  # the small budget's tasks are short
+        from evorbc_ros.repertoire import Repertoire
+        from evorbc_ros.robots.registry import lookup
+
+        episode_time = lookup(Repertoire.load(repertoire).robot).episode_time
     return ArbitratorRun(
         kind=EVORBC,
-        repertoire=step.repertoire_file or str(out / recipe.step(step.repertoire).out),
+        repertoire=repertoire,
         seed=step.seed,
         generations=generations,
         out=str(target),
         **{key: str(path) for key, path in files.items() if path is not None},
+        episode_time=episode_time,
         init_from=init,
     )

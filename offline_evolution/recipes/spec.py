@@ -94,6 +94,9 @@ class ArbitratorStep(_Common):
     neat: str | None = setting(None, doc="NEAT settings file (default: the settings')")
     task: str | None = setting(None, doc="task settings file (default: the settings')")
     generations: int | None = setting(None, doc="generations (default: the settings')", minimum=1)
+    robot_episode_time: bool | None = setting(
+        None, doc="true: episodes as long as the robot's registration declares, not the task's"
+    )
     init_from: str | None = setting(None, doc="the earlier step whose network it starts from")
     init_from_file: str | None = setting(None, doc="an arbitrator file to start from")
 

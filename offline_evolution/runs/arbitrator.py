@@ -59,6 +59,7 @@ class ArbitratorRun:
     config: str | None = None  # run settings (YAML)
     neat_config: str | None = None  # NEAT settings (neat-python INI)
     task: str | None = None  # task settings (YAML)
+    episode_time: float | None = None  # s, in place of the task's episode_time
     checkpoint: str | None = None  # default: OUT.checkpoint.json
     checkpoint_every: int | None = None  # generations (default: the run settings')
     restart: bool = False  # discard an existing checkpoint
@@ -198,6 +199,9 @@ def _plan(run: ArbitratorRun, report: Reporter) -> _Plan:
     neat_file = Path(run.neat_config) if run.neat_config else settings_file.neat_path()
     task_source = str(run.task or settings_file.task_path())
     task_settings = MazeTaskSettings.load(run.task or settings_file.task_path())
+    if run.episode_time is not None:  # recorded with the task, which evaluate reads
+        values = {**task_settings.as_dict(), "episode_time": run.episode_time}
+        task_settings = MazeTaskSettings.from_dict(values, f"--episode-time {run.episode_time:g}")
     task_settings = _check_mazes(task_settings, run.seed, robot, task_source, report)
     # The NEAT settings, the task's sensor layout and a network to start from, before any
     # work.

@@ -15,9 +15,14 @@ residual ``observed - expected`` (same units as outcomes). The kernel is Wendlan
 ``r = 0``, exactly 0 beyond ``r = 1``), so an observation corrects only primitives within
 one length scale of it, and the prior stays exact elsewhere.
 
-The observations sit in a ring of ``K`` slots. ``kzx[s]`` is the kernel row between slot
-``s``'s primitive and every primitive; adding an observation computes one row (O(n)),
-solves the slots' kernel system (O(K^3), K = 32) and corrects every primitive (O(n K)).
+The observations sit in a ring of ``K`` slots, one per primitive observed. ``kzx[s]`` is
+the kernel row between slot ``s``'s primitive and every primitive; adding an observation
+computes one row (O(n)), solves the slots' kernel system (O(K^3), K = 32) and corrects
+every primitive (O(n K)). A slot holds the running mean of its primitive's observations,
+an exponential one (weight ``1 / average`` on the newest) once ``average`` came, with the
+noise variance divided by their number up to ``average`` (the variance of a mean of
+independent readings); ``average`` 1 keeps the latest alone (docs/design/adaptation.md,
+"Repeated observations").
 """
 
 from __future__ import annotations
@@ -79,6 +84,7 @@ def refit(
     residual: np.ndarray,
     m: int,
     noise: float,
+    hits: np.ndarray,
     inverse: np.ndarray,
     alpha: np.ndarray,
     correction: np.ndarray,
@@ -88,17 +94,20 @@ def refit(
     Args:
         kzx: ``(K, n)`` kernel rows of the slots.
         slots: ``(K,)`` primitive rows of the slots (the first ``m`` used).
-        residual: ``(K, 3)`` observed minus expected outcome per slot.
+        residual: ``(K, 3)`` observed minus expected outcome per slot (the mean of its
+            ``hits`` observations).
         m: slots in use (1..K).
         noise: observation noise variance over the prior's (unitless, > 0).
-        inverse: ``(K, K)`` written: ``(Kzz + noise I)^-1`` in ``[:m, :m]``.
-        alpha: ``(K, 3)`` written: ``(Kzz + noise I)^-1 residual``.
+        hits: ``(K,)`` int64 observations averaged in each slot (>= 1 where used): the
+            slot's noise is ``noise / hits`` (``noise`` itself for 1, bit for bit).
+        inverse: ``(K, K)`` written: ``(Kzz + diag(noise / hits))^-1`` in ``[:m, :m]``.
+        alpha: ``(K, 3)`` written: that inverse times ``residual``.
         correction: ``(3, n)`` written: the posterior mean residual of every primitive.
     """
     a = np.empty((m, m))
     for s in range(m):
         a[:, s] = kzx[s, slots[:m]]
-        a[s, s] += noise
+        a[s, s] += noise / hits[s]
     alpha[:] = 0.0
     gauss_jordan(a, m, residual, inverse, alpha)
     correction[:] = 0.0
@@ -141,9 +150,17 @@ def nearest_outcome(outcomes: np.ndarray, target: np.ndarray, weight: np.ndarray
     return int(np.argmin(e0 * e0 + e1 * e1 + e2 * e2))
 
 
-#: Rows of a model's ``counts`` (int64 ``(3,)``): slots in use, the ring's next slot, and
-#: observations taken since the last reset.
-USED, NEXT_SLOT, OBSERVATIONS = 0, 1, 2
+#: Rows of a model's ``counts`` (int64 ``(HITS + K,)``): slots in use, the ring's next slot,
+#: observations taken since the last reset, the most observations a slot averages (the
+#: settings' ``average``, kept by a reset), then each slot's averaged observations.
+USED, NEXT_SLOT, OBSERVATIONS, AVERAGE, HITS = 0, 1, 2, 3, 4
+
+
+def new_counts(capacity: int, average: int) -> np.ndarray:
+    """A model's ``counts`` with nothing observed: ``(HITS + capacity,)`` int64."""
+    counts = np.zeros(HITS + capacity, dtype=np.int64)
+    counts[AVERAGE] = average
+    return counts
 
 
 def observe(
@@ -166,16 +183,18 @@ def observe(
 ):
     """Take what primitive ``index`` did, ``(o0 m, o1 m, o2 rad)`` over ``T``, and refit.
 
-    A primitive already in the ring has its slot's residual replaced (the latest
-    observation stands; its kernel row is unchanged); another takes ``counts[NEXT_SLOT]``,
-    pushing out the oldest when the ring of ``K = len(slots)`` is full.
+    A primitive already in the ring updates its slot (its kernel row is unchanged): the
+    slot's residual becomes the running mean of its last ``counts[AVERAGE]`` observations
+    (the latest alone for 1), an exponential one once more came. Another takes
+    ``counts[NEXT_SLOT]``, pushing out the oldest when the ring of ``K = len(slots)`` is
+    full.
 
     Args:
         features, recorded, expected: ``(n, 3)`` (see the module and
             :class:`~evorbc_ros.adaptation.model.OutcomeModel`).
         kzx, slots, residual, inverse, alpha, correction: as :func:`refit`, updated.
         corrected: ``(n, 3)`` written: ``recorded`` plus the correction (m, m, rad).
-        counts: ``(3,)`` int64 ``[USED, NEXT_SLOT, OBSERVATIONS]``, updated.
+        counts: ``(HITS + K,)`` int64 (:data:`USED` ... :data:`HITS`), updated.
         noise: as :func:`refit`.
     """
     used = counts[USED]
@@ -191,11 +210,22 @@ def observe(
         counts[USED] = used
         slots[s] = index
         kernel_row(features, index, kzx[s])
-    residual[s, 0] = o0 - expected[index, 0]
-    residual[s, 1] = o1 - expected[index, 1]
-    residual[s, 2] = o2 - expected[index, 2]
+        counts[HITS + s] = 0
+    h = min(counts[HITS + s] + 1, counts[AVERAGE])
+    counts[HITS + s] = h
+    r0 = o0 - expected[index, 0]
+    r1 = o1 - expected[index, 1]
+    r2 = o2 - expected[index, 2]
+    if h <= 1:  # the latest stands: assigned, not averaged, so its bits are the reading's
+        residual[s, 0] = r0
+        residual[s, 1] = r1
+        residual[s, 2] = r2
+    else:
+        residual[s, 0] += (r0 - residual[s, 0]) / h
+        residual[s, 1] += (r1 - residual[s, 1]) / h
+        residual[s, 2] += (r2 - residual[s, 2]) / h
     counts[OBSERVATIONS] += 1
-    refit(kzx, slots, residual, used, noise, inverse, alpha, correction)
+    refit(kzx, slots, residual, used, noise, counts[HITS:], inverse, alpha, correction)
     # Whole columns: one IEEE addition per element either way, and plain numpy pays per
     # call, not per element (as a loop over elements it cost 9 ms a refit at 10,000).
     for c in range(3):
@@ -205,6 +235,7 @@ def observe(
 #: The functions above, callees first (each may call only those before it).
 FUNCTIONS = (
     "wendland",
+    "new_counts",
     "kernel_row",
     "gauss_jordan",
     "refit",

@@ -45,6 +45,9 @@ class AdaptationSettings:
             its oscillation within a period averages out over ``min_cycles``).
         min_cycles: the fewest settled cycles an observation sums; a shorter execution
             is not observed.
+        average: the most observations of one primitive its slot averages (a running
+            mean, exponential beyond; the slot's noise is ``noise`` over their number).
+            1: the latest observation stands alone.
         match: ``outcome``: the primitive whose corrected outcome is nearest the
             recorded outcome of the primitive the grid chose (what the network asked
             for), each dimension over the repertoire's extent in it; ``point``: the one
@@ -61,6 +64,7 @@ class AdaptationSettings:
     match: str = "outcome"
     steady: str = "agree"
     min_cycles: int = 1
+    average: int = 1
 
     def __post_init__(self) -> None:
         checks = (
@@ -71,6 +75,7 @@ class AdaptationSettings:
             ("steady_tolerance", 0.0 <= self.steady_tolerance <= 10.0, "in [0, 10]"),
             ("window", 1 <= self.window <= 1000, "between 1 and 1000"),
             ("min_cycles", 1 <= self.min_cycles <= self.window, "between 1 and window"),
+            ("average", 1 <= self.average <= 1000, "between 1 and 1000"),
         )
         if self.match not in MATCHES:
             raise ValueError(f"adaptation match must be one of {', '.join(MATCHES)}")
@@ -150,9 +155,9 @@ class OutcomeModel:
         self.alpha = np.zeros((k, 3))
         self.correction = np.zeros((3, n))
         self.corrected = self.recorded.copy()
-        #: ``[used, next_slot, observations]`` (:data:`gp.USED` ...): int64, so that the
-        #: compiled :func:`gp.observe` updates them in place.
-        self.counts = np.zeros(3, dtype=np.int64)
+        #: ``[used, next_slot, observations, average, hits per slot...]`` (:data:`gp.USED`
+        #: ...): int64, so that the compiled :func:`gp.observe` updates them in place.
+        self.counts = gp.new_counts(k, settings.average)
 
     @property
     def used(self) -> int:
@@ -173,7 +178,7 @@ class OutcomeModel:
         self.residual[:] = 0.0
         self.correction[:] = 0.0
         self.corrected[:] = self.recorded
-        self.counts[:] = 0
+        self.counts[:] = gp.new_counts(self.settings.capacity, self.settings.average)
 
     def arrays(self) -> tuple:
         """The arrays :func:`gp.observe` takes, in its order, up to ``counts``."""
@@ -194,9 +199,10 @@ class OutcomeModel:
     def observe(self, index: int, outcome: np.ndarray) -> None:
         """Take what primitive ``index`` did, as ``(dx, dy, dheading)`` over ``T``.
 
-        A primitive already in the ring has its slot's residual replaced (the latest
-        observation stands; its kernel column is unchanged); another takes the next slot,
-        pushing out the oldest when the ring is full (:func:`gp.observe`).
+        A primitive already in the ring updates its slot's running mean (the latest
+        observation alone with ``average`` 1; its kernel column is unchanged); another
+        takes the next slot, pushing out the oldest when the ring is full
+        (:func:`gp.observe`).
         """
         o0, o1, o2 = (float(v) for v in outcome)
         self.gp["observe"](*self.arrays(), self.settings.noise, int(index), o0, o1, o2)

@@ -226,7 +226,9 @@ def _gait_and_servo(derived: DerivedRobot, hz: float) -> list[str]:
 
 
 def _physics() -> list[str]:
-    """The physics rate, solver, friction, tilts and control period: the A1's."""
+    """Physics rate, solver, friction, tilts, control period: the A1's but the discard tilt."""
+    from sim_bridge.legged.gait_measures import POOL_TILT  # imports PyBullet: here only
+
     rate_steps = "control_period and settle_time are whole steps"
     return [
         "physics:",
@@ -236,7 +238,12 @@ def _physics() -> list[str]:
         "  settle_time: 1.0  # s standing before the rest state every primitive starts from",
         "  wall_height: 0.4  # m",
         "tilt:",
-        "  discard_deg: 45  # eq. 6: a primitive tilting more is discarded",
+        # The design search's switching measure chains only primitives steady within
+        # POOL_TILT; a repertoire keeping more tilted ones falls in its mazes where that
+        # measure said it would not (the Laikago: 42 of a 45-deg repertoire's 118
+        # primitives fell held 30 s, 16 of the 92 within 20 deg; docs/your-robot.md).
+        f"  discard_deg: {math.degrees(POOL_TILT):g}  # eq. 6: a primitive tilting more is "
+        "discarded; the design search's steady pool (the A1's and hexapod's: 45)",
         "  fallen_deg: 90  # an episode ends: the robot fell over",
         "control_period: 0.1  # s",
     ]
@@ -273,13 +280,23 @@ def _drive(leg: Leg, role: str) -> str:
     )
 
 
-def declaration_text(name: str, model_file: str, description: str) -> str:
+def declaration_text(
+    name: str,
+    model_file: str,
+    description: str,
+    episode_time: float = 30.0,
+    episode_note: str = "the A1's",
+) -> str:
     """The robot file registering the robot (docs/legged.md, "Registering it").
 
     Its repertoire, arbitrator, NEAT, task, sensor and maze settings are the A1's, named
     ``config:NAME`` (evorbc's ``config/`` wherever it is installed,
     :data:`evorbc_ros.settings_paths.SHIPPED_PREFIX`): copy one beside it to change it.
+    ``episode_time`` (s) is the A1's unless a gait design fitted it (``episode_note``
+    says how, as a comment); the standard-NEAT baseline's extra generations follow it
+    (the A1's repertoire evaluations, 1.025 M x 2 s, over population 150 x an episode).
     """
+    equal_budget = int(1_025_000 * 2.0 / (150 * float(episode_time)))
     return (
         f'# {name}: the robot file registering {model_file} (docs/legged.md, "Registering it").\n'
         "# Put this folder on $EVORBC_ROBOT_PATH. The search, sensor and maze settings are the\n"
@@ -295,6 +312,7 @@ def declaration_text(name: str, model_file: str, description: str) -> str:
         "  task: config:tasks/maze-a1.yaml\n"
         "sensors: config:sensors/a1.yaml\n"
         "maze: a1\n"
-        "episode_time: 30.0\n"
-        "equal_budget_generations: 455  # 1.025M x 2 s over 150 x 30 s, the A1's\n"
+        f"episode_time: {float(episode_time)!r}  # s, {episode_note}\n"
+        f"equal_budget_generations: {equal_budget}  # 1.025M x 2 s over 150 x "
+        f"{float(episode_time):g} s, as the A1's\n"
     )
