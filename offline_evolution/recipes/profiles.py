@@ -143,7 +143,7 @@ def write_profile_recipe(
             "seed": seed,
             # A URDF robot's episode is as long as its designed gait needs
             # (gait_design/maze_needs.py, fitted_episode_time), not the A1's task's 30 s.
-            **({"robot_episode_time": True} if robot == {"robot_step": "design"} else {}),
+            **({"robot_episode_time": True} if is_urdf(source) else {}),
             "out": f"{name}.arbitrator.json",
         }
     )
