@@ -46,6 +46,7 @@ import rclpy
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import PointStamped
 from nav_msgs.msg import Odometry
+from rclpy.duration import Duration
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState, LaserScan
@@ -72,6 +73,12 @@ from evorbc_ros.robots import registry
 from sim_bridge.bridge_parameters import PARAMETERS, REMOVED
 from sim_bridge.rejoins import RejoinWatch
 from sim_bridge.verdict import episode_verdict
+
+#: Longest time (wall s) the lockstep bridge waits, after its final state, for every reader
+#: to acknowledge its state messages. A recorder on a loaded machine may be a few cycles
+#: behind when the run ends; a bridge that exits first takes those messages with it
+#: (docs/design/ros-graph.md, "Recording and playback").
+DELIVERY_LIMIT = 10.0
 
 #: Topics of the graph besides the commands: each has exactly one publisher in one run.
 GRAPH_TOPICS = (
@@ -445,8 +452,28 @@ class SimBridgeNode(Node):
                 self.advance()
             if running():
                 self.publish_state()  # final state for listeners
+                self.deliver_state()
         finally:
             executor.remove_node(self)
+
+    def deliver_state(self) -> None:
+        """Wait until every reader has acknowledged the state messages, or DELIVERY_LIMIT.
+
+        A reliable reader acknowledges a message once it holds it, so a recorder stopped
+        after this bridge ends has the whole run to write. A reader that never acknowledges
+        (a node that died without leaving the graph) costs the limit and a warning.
+        """
+        deadline = time.monotonic() + DELIVERY_LIMIT
+        late = []
+        for pub in (self.clock_pub, self.scan_pub, self.odom_pub, self.joint_pub):
+            left = max(0.0, deadline - time.monotonic())
+            if not pub.wait_for_all_acked(Duration(seconds=left)):
+                late.append(pub.topic_name)
+        if late:
+            self.get_logger().warning(
+                f"a reader did not acknowledge the last state on {', '.join(late)} within "
+                f"{DELIVERY_LIMIT:.0f} s; it may lack the end of the run"
+            )
 
     def run_realtime(self) -> None:
         """Step every 0.1 s of wall time with whatever commands are current."""

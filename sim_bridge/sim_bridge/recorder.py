@@ -69,6 +69,9 @@ DEPTH = 1000
 DISCOVERY_PERIOD = 0.1
 #: Longest time (wall s) spent taking already-delivered messages after a stop request.
 DRAIN_LIMIT = 2.0
+#: Quiet time (wall s) that ends the drain: on a loaded machine the middleware's threads
+#: may hand over a delivered message only a few ms after it arrived.
+DRAIN_QUIET = 0.05
 #: ``pkg/msg/Name``: the message types a subscription can be made for.
 MESSAGE_TYPE = re.compile(r"([A-Za-z][A-Za-z0-9_]*)/msg/([A-Za-z][A-Za-z0-9_]*)")
 
@@ -239,7 +242,8 @@ class RecorderNode(Node):
         """Take the messages already delivered when the stop came, within DRAIN_LIMIT.
 
         The last messages of a run (the bridge's final state, the last choice) may still
-        wait in the subscriptions when the graph is stopped all at once.
+        wait in the subscriptions when the graph is stopped all at once. (The lockstep
+        bridge ends only once its state messages are acknowledged, that is held here.)
         """
         executor = Executor(context=self.context)
         executor.add_node(self)
@@ -247,10 +251,10 @@ class RecorderNode(Node):
         idle = 0
         try:
             # A spin that writes nothing may have run the clock or the timer instead; three
-            # in a row mean nothing is left.
+            # in a row, each after waiting DRAIN_QUIET, mean nothing is left.
             while idle < 3 and time.monotonic() < deadline and self.context.ok():
                 before = self.written
-                executor.spin_once(timeout_sec=0.0)
+                executor.spin_once(timeout_sec=DRAIN_QUIET)
                 idle = idle + 1 if self.written == before else 0
         finally:
             executor.remove_node(self)
