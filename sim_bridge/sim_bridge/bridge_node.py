@@ -79,6 +79,8 @@ from sim_bridge.verdict import episode_verdict
 #: behind when the run ends; a bridge that exits first takes those messages with it
 #: (docs/design/ros-graph.md, "Recording and playback").
 DELIVERY_LIMIT = 10.0
+#: Wall s of one wait for acknowledgements between checks for a stop request.
+ACK_SLICE = 0.1
 
 #: Topics of the graph besides the commands: each has exactly one publisher in one run.
 GRAPH_TOPICS = (
@@ -466,9 +468,13 @@ class SimBridgeNode(Node):
         deadline = time.monotonic() + DELIVERY_LIMIT
         late = []
         for pub in (self.clock_pub, self.scan_pub, self.odom_pub, self.joint_pub):
-            left = max(0.0, deadline - time.monotonic())
-            if not pub.wait_for_all_acked(Duration(seconds=left)):
-                late.append(pub.topic_name)
+            # In slices, so that a stop request (Ctrl-C) is not held up by a silent reader.
+            while not pub.wait_for_all_acked(Duration(seconds=ACK_SLICE)):
+                if not running() or time.monotonic() > deadline:
+                    late.append(pub.topic_name)
+                    break
+        if not running():
+            return
         if late:
             self.get_logger().warning(
                 f"a reader did not acknowledge the last state on {', '.join(late)} within "

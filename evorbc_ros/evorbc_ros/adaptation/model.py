@@ -89,9 +89,13 @@ class AdaptationSettings:
 #: A legged robot's settings: its 0.1 s cycles never agree within ``steady_tolerance`` (the
 #: body sways and yaws within each gait period), so every held cycle after the first is
 #: summed and an observation is a whole ``min_cycles`` = ``window`` = 5 cycles (0.5 s, half
-#: to more than one period of a 1-2.5 Hz gait). Measured on the training mazes
-#: (docs/design/adaptation.md, "Legged robots").
-LEGGED_SETTINGS = AdaptationSettings(steady="held", window=5, min_cycles=5)
+#: to more than one period of a 1-2.5 Hz gait). One such execution scatters about its
+#: primitive's mean by six times the repertoire's spacing (the gait's phase, the primitive
+#: before), so a slot keeps the running mean of its primitive's observations (up to 10,
+#: then exponential, weight 1/10 on the newest) with the prior's variance as one
+#: reading's noise. Chosen on the training mazes, never the
+#: held-out ones (docs/design/adaptation.md, "Legged robots", "Repeated observations").
+LEGGED_SETTINGS = AdaptationSettings(steady="held", window=5, min_cycles=5, noise=1.0, average=10)
 
 
 #: The registry's families whose robots walk (docs/legged.md).
