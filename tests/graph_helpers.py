@@ -4,12 +4,34 @@ import json
 import os
 import signal
 import subprocess
+from pathlib import Path
 
 import numpy as np
 from ros_domains import claim_domain
 
 from evorbc_ros.defaults import default_arbitrator
 from sim_bridge.bringup import NODES, node_command
+
+
+def children(pid: int) -> list[int]:
+    """The processes whose parent is ``pid``."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue  # gone meanwhile
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+def cmdline(pid: int) -> str:
+    """The command line of process ``pid``, words joined by spaces ("" once it is gone)."""
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
+    except OSError:
+        return ""
 
 
 def graph_env(domain: int) -> dict:

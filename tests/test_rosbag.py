@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from graph_helpers import graph_env
+from graph_helpers import children, cmdline, graph_env
 from install_helpers import assert_fatal_line
 from mcap.reader import make_reader
 from nav_msgs.msg import Odometry
@@ -506,19 +506,6 @@ def test_a_lockstep_run_is_recorded_whole_from_its_first_cycle(recorded):
     assert all(c.clock is not None for c in recording.cycles)
 
 
-def child_running(parent: int, module: str) -> int | None:
-    """The pid of ``parent``'s child process that runs ``python -m module``, if any."""
-    for entry in Path("/proc").iterdir():
-        try:
-            stat = (entry / "stat").read_text()
-            cmdline = (entry / "cmdline").read_bytes().split(b"\0")
-        except (OSError, ValueError):
-            continue  # not a process, or gone
-        if int(stat.rsplit(")", 1)[1].split()[1]) == parent and module.encode() in cmdline:
-            return int(entry.name)
-    return None
-
-
 @pytest.mark.slow
 def test_a_recorder_behind_at_the_end_of_the_run_still_gets_all_of_it(tmp_path):
     # The recorder is frozen from t = 50 s of the 81.9 s run until 3 s after the bridge's
@@ -540,8 +527,9 @@ def test_a_recorder_behind_at_the_end_of_the_run_still_gets_all_of_it(tmp_path):
         for line in proc.stdout:
             seen.append(line)
             if recorder is None and re.search(r"\[sim_bridge\]: t = +50\.0 s", line):
-                recorder = child_running(proc.pid, "sim_bridge.recorder")
-                assert recorder is not None, "".join(seen)
+                found = [p for p in children(proc.pid) if "sim_bridge.recorder" in cmdline(p)]
+                assert len(found) == 1, "".join(seen)
+                recorder = found[0]
                 os.kill(recorder, signal.SIGSTOP)
             elif recorder is not None and re.search(r"\[sim_bridge\]: t = +80\.0 s", line):
                 thawed = threading.Timer(3.0, os.kill, (recorder, signal.SIGCONT))
