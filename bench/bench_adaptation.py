@@ -13,6 +13,10 @@ shipped repertoire, and prints p50 and p99 of the cost per cycle in ms, in two r
 * ``worst``: every cycle takes an observation of a primitive not yet in the full ring of
   32 (a new kernel row, the 32 x 32 solve, every primitive's correction), then matches.
 
+Each regime runs with the wheeled default settings and with the legged default
+(``LEGGED_SETTINGS``: whole executions of at least 5 held cycles observed, a running mean
+of up to 10 observations a primitive, docs/design/adaptation.md).
+
 Both with the plain functions (numpy, as onboard) and the numba-compiled ones (as the
 offline kernels would call them). One core: the process is pinned to one CPU and BLAS and
 numba use one thread. Times are the thread's CPU time (``time.thread_time``), not wall
@@ -30,6 +34,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import argparse
+import itertools
 import math
 import time
 
@@ -37,7 +42,7 @@ import numpy as np
 from bench_repertoire import machine
 
 from evorbc_ros.adaptation import AdaptationSettings, OnlineAdaptation, cycles
-from evorbc_ros.adaptation.model import OutcomeModel, outcome_table
+from evorbc_ros.adaptation.model import LEGGED_SETTINGS, OutcomeModel, outcome_table
 from evorbc_ros.adaptation.motion import extend_arc
 from evorbc_ros.defaults import default_repertoire
 from evorbc_ros.repertoire import Repertoire
@@ -118,12 +123,14 @@ def main() -> None:
     cases.append((f"{len(rep)} ({largest}, largest shipped)", shipped))
     cases.append(("10000 synthetic", synthetic(10_000, np.random.default_rng(10_000))))
     regimes = {"driving": run, "worst": worst}
-    settings = AdaptationSettings()
+    defaults = {"wheeled": AdaptationSettings(), "legged": LEGGED_SETTINGS}
     print(f"machine: {machine()}, one core; {args.cycles} cycles per row; ms per cycle")
-    print(f"{'repertoire':34s} {'regime':8s} {'plain p50':>10s} {'p99':>7s} {'max':>7s} "
-          f"{'numba p50':>10s} {'p99':>7s}")  # fmt: skip
+    print(f"{'repertoire':34s} {'settings':8s} {'regime':8s} {'plain p50':>10s} {'p99':>7s} "
+          f"{'max':>7s} {'numba p50':>10s} {'p99':>7s}")  # fmt: skip
     for label, outcomes in cases:
-        for regime, measure in regimes.items():
+        for (kind, settings), (regime, measure) in itertools.product(
+            defaults.items(), regimes.items()
+        ):
             row = []
             for functions in (None, compiled):
                 measure(outcomes, settings, functions, 50, np.random.default_rng(0), 12)  # warm
@@ -132,7 +139,7 @@ def main() -> None:
                 row.append(times)
             plain, jitted = row
             print(
-                f"{label:34s} {regime:8s} {np.median(plain):10.3f} "
+                f"{label:34s} {kind:8s} {regime:8s} {np.median(plain):10.3f} "
                 f"{np.quantile(plain, 0.99):7.3f} {plain.max():7.3f} "
                 f"{np.median(jitted):10.3f} {np.quantile(jitted, 0.99):7.3f}"
             )
