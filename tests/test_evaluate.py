@@ -203,3 +203,29 @@ def test_reach_interval_is_wilsons():
     wide, narrow = reach_interval(15, 20), reach_interval(750, 1000)
     assert narrow[0] > wide[0] and narrow[1] < wide[1]
     assert reach_interval(0, 0) == (0.0, 1.0)
+
+
+def test_a_legged_fall_is_timed_when_it_happens_as_replay_times_it():
+    # The shipped A1 controller from 10 seeded starts in its own maze: 3 of them fall
+    # (at 1.8, 7.1 and 29.1 s). Each fallen episode's time is the cycles it ran, as
+    # replay and the bridge report a fall ("fell after 7.1 s"), not the episode's 30 s,
+    # and its recorded path ends there.
+    from evorbc_ros.defaults import default_arbitrator
+
+    arb = ArbitratorFile.load(default_arbitrator("a1"))
+    task = make_task(MazeTaskSettings(**arb.evolution["task"]), "a1", workers=1)
+    try:
+        controller = task.controller(
+            "evorbc", Repertoire.load(default_repertoire("a1")), arb.mapping
+        )
+        result = evaluate_suite(task, arb.network, controller, 10, 0)
+    finally:
+        task.close()
+    fell = [k for k, e in enumerate(result.episodes) if e.fell]
+    assert fell, "no episode fell: pick starts in which the shipped A1 falls"
+    for k in fell:
+        episode, path = result.episodes[k], result.paths[k]
+        assert not episode.reached and episode.time < task.settings.episode_time
+        assert round(episode.time / task.dt) == len(path) - 1
+    ran_out = [e for e in result.episodes if not e.reached and not e.fell]
+    assert all(e.time == pytest.approx(task.settings.episode_time) for e in ran_out)

@@ -22,6 +22,7 @@ import numpy as np
 
 from offline_evolution.maze_task.base import MazeTaskBase
 from offline_evolution.maze_task.perturbation import NONE, PerturbationSet, check_damage
+from offline_evolution.maze_task.replay import cycles_run
 from offline_evolution.mazes.paths import solve
 from sim_bridge.damage import describe, part_names
 
@@ -44,7 +45,7 @@ class SuiteEpisode:
     start: tuple[float, float, float]  # x m, y m, heading rad (after any start error)
     reached: bool
     fitness: float
-    time: float  # s until the target, or the episode's end
+    time: float  # s until the target, the fall (as replay and the bridge time it), or the end
     final_distance: float  # m, straight line to the target
     end: tuple[float, float, float]  # the last pose: x m, y m, heading rad (maze frame)
     stalled: bool
@@ -219,6 +220,9 @@ def evaluate_suite(
     for e, row in enumerate(starts):
         k = int(row[0])
         maze, n = task.mazes[k], int(result.cycles[e])
+        # A fall ends the episode, though eq. 5 scores it over all its cycles: time it by
+        # the cycles run, as replay and the bridge do ("fell after 11.7 s").
+        ran = cycles_run(result, e) if result.choice is not None else n
         pose = result.pose[e, : n + 1]
         pose = pose[np.isfinite(pose[:, 0])]  # a legged robot that fell stops its trace early
         xs, ys = pose[:, 0], pose[:, 1]
@@ -230,7 +234,7 @@ def evaluate_suite(
                 start=(float(row[1]), float(row[2]), float(row[3])),
                 reached=bool(result.reached[e]),
                 fitness=float(result.fitness[e]),
-                time=n * task.dt,
+                time=ran * task.dt,
                 final_distance=float(result.final_distance[e]),
                 end=tuple(float(v) for v in pose[-1]),
                 stalled=stalled(to_go, window, step),
