@@ -6,10 +6,13 @@ rest on flat ground (no walls), each switching to a primitive drawn uniformly fr
 repertoire every ``--period`` s (several periods compare), the gait clock running on as
 the executor's does, and reports how many fell (body tilt past the robot's fallen tilt)
 and when: the fall rate that switching itself brings, to set against a controller's
-falls in its mazes (docs/your-robot.md).
+falls in its mazes (docs/your-robot.md). ``--blend S`` eases each switch, the joint
+targets ramped from the previous primitive's to the new one's over S s (an experiment:
+the executor switches at once).
 
     python bench/legged_switching.py REPERTOIRE.json [--settings MODEL.yaml]
-        [--periods 0.1 0.5 2] [--episodes 20] [--time 30] [--seed 0] [--json FILE]
+        [--periods 0.1 0.5 2] [--episodes 20] [--time 30] [--seed 0] [--blend 0]
+        [--json FILE]
 
 A robot made by a recipe needs its folder on ``$EVORBC_ROBOT_PATH`` (``DIR/robots``);
 ``--settings`` defaults to the registered robot's model file.
@@ -28,12 +31,25 @@ from evorbc_ros.atomic_io import atomic_write_text
 from evorbc_ros.repertoire import Repertoire
 
 
-def switching(sim, table, rows: np.ndarray, period: float, fallen: float) -> float:
-    """s at which the body fell (inf: never), running ``rows[k]`` in the k-th period."""
+def switching(sim, table, rows: np.ndarray, period: float, fallen: float, blend: float) -> float:
+    """s at which the body fell (inf: never), running ``rows[k]`` in the k-th period.
+
+    ``blend`` s: after a switch the joint targets move linearly from the previous
+    primitive's to the new one's (both at the same gait times) over that long; 0: at once,
+    as the executor switches.
+    """
     sim.reset()
-    steps = max(1, round(period / sim.settings.physics.dt))  # physics steps a period
+    dt = sim.settings.physics.dt
+    steps = max(1, round(period / dt))  # physics steps a period
+    ramp = np.clip((np.arange(steps) + 1) * dt / blend, 0.0, 1.0)[:, None] if blend > 0 else 1.0
+    previous = None
     for row in rows:
-        targets = table.joint_targets(sim.step_times(steps), np.full(steps, row))
+        times = sim.step_times(steps)
+        targets = table.joint_targets(times, np.full(steps, row))
+        if previous is not None and previous != row and blend > 0:
+            before = table.joint_targets(times, np.full(steps, previous))
+            targets = before + ramp * (targets - before)
+        previous = row
         tilt, _ = sim.run(targets, fallen)
         if tilt > fallen:
             return sim.time
@@ -52,6 +68,7 @@ def main() -> None:
     parser.add_argument("--episodes", type=int, default=20)
     parser.add_argument("--time", type=float, default=30.0, help="s an episode")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--blend", type=float, default=0.0, help="s a switch's ramp lasts")
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
     rep = Repertoire.load(args.repertoire)
@@ -64,7 +81,7 @@ def main() -> None:
             rng = np.random.default_rng([args.seed, round(period * 1000)])
             draws = rng.integers(len(rep), size=(args.episodes, math.ceil(args.time / period)))
             falls = np.array(
-                [switching(sim, table, d, period, settings.fallen_tilt) for d in draws]
+                [switching(sim, table, d, period, settings.fallen_tilt, args.blend) for d in draws]
             )
             fell = np.isfinite(falls)
             row = {
