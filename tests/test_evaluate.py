@@ -205,22 +205,30 @@ def test_reach_interval_is_wilsons():
     assert reach_interval(0, 0) == (0.0, 1.0)
 
 
+def shipped_a1_suite(training: dict | None = None):
+    """The shipped A1 controller from 10 seeded starts in its own maze: ``(task, result)``;
+    with ``training``, scored as a training run of seed 1 scores them."""
+    from evorbc_ros.defaults import default_arbitrator
+
+    arb = ArbitratorFile.load(default_arbitrator("a1"))
+    values = {**arb.evolution["task"], **({"training": training} if training else {})}
+    task = make_task(MazeTaskSettings.from_dict(values, "the A1's task"), "a1", workers=1)
+    try:
+        if training:
+            task.start_training("a1", seed=1)
+        rep = Repertoire.load(default_repertoire("a1"))
+        controller = task.controller("evorbc", rep, arb.mapping)
+        return task, evaluate_suite(task, arb.network, controller, 10, 0)
+    finally:
+        task.close()
+
+
 def test_a_legged_fall_is_timed_when_it_happens_as_replay_times_it():
     # The shipped A1 controller from 10 seeded starts in its own maze: 3 of them fall
     # (at 1.8, 7.1 and 29.1 s). Each fallen episode's time is the cycles it ran, as
     # replay and the bridge report a fall ("fell after 7.1 s"), not the episode's 30 s,
     # and its recorded path ends there.
-    from evorbc_ros.defaults import default_arbitrator
-
-    arb = ArbitratorFile.load(default_arbitrator("a1"))
-    task = make_task(MazeTaskSettings(**arb.evolution["task"]), "a1", workers=1)
-    try:
-        controller = task.controller(
-            "evorbc", Repertoire.load(default_repertoire("a1")), arb.mapping
-        )
-        result = evaluate_suite(task, arb.network, controller, 10, 0)
-    finally:
-        task.close()
+    task, result = shipped_a1_suite()
     fell = [k for k, e in enumerate(result.episodes) if e.fell]
     assert fell, "no episode fell: pick starts in which the shipped A1 falls"
     for k in fell:
@@ -229,3 +237,17 @@ def test_a_legged_fall_is_timed_when_it_happens_as_replay_times_it():
         assert round(episode.time / task.dt) == len(path) - 1
     ran_out = [e for e in result.episodes if not e.reached and not e.fell]
     assert all(e.time == pytest.approx(task.settings.episode_time) for e in ran_out)
+
+
+def test_a_fall_penalty_lowers_exactly_the_fallen_episodes_fitness():
+    # training.fall_penalty: eq. 5 scores a fall by the progress made before it, as a
+    # time-out; the penalty is subtracted from the episodes that fell, and only those.
+    training = {"generated": 1, "maze_seed": 1, "post_mazes": 0}
+    _, plain = shipped_a1_suite(training)
+    _, penalised = shipped_a1_suite({**training, "fall_penalty": 1.0})
+    fell = np.array([e.fell for e in plain.episodes])
+    assert fell.any() and not fell.all()
+    assert [e.fell for e in penalised.episodes] == fell.tolist()  # the same episodes
+    got = np.array([e.fitness for e in penalised.episodes])
+    want = np.array([e.fitness for e in plain.episodes]) - fell
+    np.testing.assert_array_equal(got, want)

@@ -218,6 +218,7 @@ def _net():
         ({"serpentine": 1.0}, "serpentine must be <= 0.9"),
         ({"adapt": True, "adapt_expected": "nosuch"}, "adapt_expected 'nosuch': expected one"),
         ({"post_perturb": True}, "post_perturb needs a perturb set"),
+        ({"fall_penalty": -1.0}, "fall_penalty must be >= 0"),
     ],
 )
 def test_bad_training_settings_are_one_line_errors(tmp_path, training, message):

@@ -450,13 +450,17 @@ class MazeTaskBase(abc.ABC):
         ``ends``: ``(maze (E,) int, start (E, 2), end (E, 2))``, each episode's maze row and
         its first and last positions (m); with ``training.distance: path`` a missed
         episode's fitness uses the path lengths from them (``final`` and ``initial`` stay
-        the straight-line distances the result reports).
+        the straight-line distances the result reports). ``fell`` ``(E,)`` bool: with
+        ``training.fall_penalty`` a fallen episode's fitness is lowered by it.
         """
         pose, choice, outputs = traces if traces is not None else (None, None, None)
         if ends is not None and self.training is not None and self.training.by_path:
             fitness = self.fitness(reached, cycles, *self._path_lengths(*ends))
         else:
             fitness = self.fitness(reached, cycles, final, initial)
+        penalty = self.training.settings.fall_penalty if self.training is not None else 0.0
+        if penalty and fell is not None:
+            fitness = fitness - penalty * np.asarray(fell, dtype=np.float64)
         return EpisodeResult(reached, cycles, final, initial, fitness, pose, choice, outputs, fell)
 
     def _path_lengths(self, maze, start, end) -> tuple[np.ndarray, np.ndarray]:

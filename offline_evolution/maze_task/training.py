@@ -33,7 +33,12 @@ A maze task whose settings hold a ``training`` mapping trains on the generator's
   (each start row its own world, drawn from the post-selection's seed streams), so that a
   run trained on a damaged robot writes the controller that reaches best on that robot;
   without it the post-selection runs in the nominal world, as the shipped controllers'
-  did.
+  did;
+* ``fall_penalty: P`` subtracts P from the fitness of every episode in which a legged
+  robot fell (training, nominal watch and post-selection). Eq. 5 scores a fall by the
+  progress made before it, as a time-out, so a controller that falls after going far
+  outscores one that walks safely but slower; with P = 1 a fall scores below every
+  episode that did not fall and did not lose ground (docs/your-robot.md).
 
 Generated mazes are proven solvable by the generator; a task keeps the last
 :data:`CACHE` of them (and their compiled packs, 4WS), so a pool costs its generation once.
@@ -110,6 +115,12 @@ class TrainingSettings:
     post_perturb: bool = setting(
         False, doc="the post-selection's episodes in worlds of perturb too (false: nominal)"
     )
+    fall_penalty: float = setting(
+        0.0,
+        doc="subtracted from a legged episode's fitness when the robot fell (0: eq. 5 alone)",
+        minimum=0.0,
+        maximum=10.0,
+    )
 
     @classmethod
     def from_dict(cls, values, source: str) -> TrainingSettings:
@@ -166,6 +177,7 @@ class TrainingSettings:
             **({"serpentine": self.serpentine} if self.serpentine else {}),
             **({"adapt": True, "adapt_expected": self.adapt_expected} if self.adapt else {}),
             **({"post_perturb": True} if self.post_perturb else {}),
+            **({"fall_penalty": self.fall_penalty} if self.fall_penalty else {}),
         }
 
 
