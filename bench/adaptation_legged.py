@@ -13,12 +13,15 @@ and reach per damaged leg or side. ``--out FILE.json`` writes the figures
 settled outcomes (``evaluate --adapt-expected settled``: computed first, in PyBullet);
 several (``--expected recorded settled``) run the unadapted suite once and adapt against
 each; ``--generated 0`` runs the controller's own training mazes instead of generated ones.
+``--intact FILE`` takes the intact robot's reach from an earlier ``--out`` of the same
+suite, so that each damage set can run on its own (``--sets hexapod-leg-lost``).
 ``--setting KEY=VALUE`` (repeatable) overrides a field of the robot family's default
 :class:`~evorbc_ros.adaptation.AdaptationSettings` (``noise=1.0``, ``average=8``), to compare
 settings on the training mazes before one is made the default.
 
     python bench/adaptation_legged.py [--robot hexapod] [--generated 10] [--starts 4]
         [--expected recorded settled] [--sets none hexapod-leg-lost ...] [--setting noise=1]
+        [--intact FILE]
         [--out docs/results/adaptation/hexapod.json]
 """
 
@@ -135,9 +138,14 @@ def figures(name: str, runs, adapted, observations, expected: str, began: float)
     }
 
 
-def with_losses(results: list[dict]) -> list[dict]:
-    """Each set's loss (reach points below the intact robot without adaptation) and share."""
-    intact = next(r for r in results if r["set"] == "none")["off"]["reach_pct"]
+def with_losses(results: list[dict], intact: float | None = None) -> list[dict]:
+    """Each set's loss (reach points below the intact robot without adaptation) and share.
+
+    ``intact``: the intact robot's reach without adaptation (%), when ``results`` hold no
+    ``none`` set (``--intact``).
+    """
+    if intact is None:
+        intact = next(r for r in results if r["set"] == "none")["off"]["reach_pct"]
     for r in results:
         off, on = intact - r["off"]["reach_pct"], intact - r["on"]["reach_pct"]
         r["loss_off"], r["loss_on"] = round(off, 2), round(on, 2)
@@ -187,6 +195,25 @@ def override_settings(pairs: list[str]) -> dict:
     return changes
 
 
+def intact_reach(path: str, robot: str, generated: int, starts: int) -> float:
+    """The intact robot's reach without adaptation (%) in an earlier ``--out`` file.
+
+    Raises:
+        SystemExit: one line, if the file is not of the same robot and suite or has no
+            ``none`` set.
+    """
+    with open(path, encoding="utf-8") as f:
+        earlier = json.load(f)
+    suite = (earlier.get("robot"), earlier.get("generated"), earlier.get("starts_per_maze"))
+    want = (robot, {"count": generated, "seed": 21021} if generated else suite[1], starts)
+    if suite != want:
+        raise SystemExit(f"--intact {path}: another suite ({suite}), expected {want}")
+    for r in earlier.get("sets", []):
+        if r.get("set") == "none":
+            return float(r["off"]["reach_pct"])
+    raise SystemExit(f"--intact {path}: no 'none' set in it")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robot", default="hexapod", choices=sorted(DAMAGE))
@@ -198,17 +225,24 @@ def main() -> None:
     parser.add_argument("--sets", nargs="+", default=None, help="default: none and the damage")
     parser.add_argument("--out", help="write the figures as JSON")
     parser.add_argument("--setting", action="append", default=[], metavar="KEY=VALUE")
+    parser.add_argument(
+        "--intact", help="an --out file of the same suite with 'none', when --sets lacks it"
+    )
     args = parser.parse_args()
     changes = override_settings(args.setting)
     sets = args.sets or ["none", *DAMAGE[args.robot]]
+    intact = None
     if "none" not in sets:
-        parser.error("--sets: the losses are against 'none', the intact robot")
+        if not args.intact:
+            parser.error("--sets: the losses are against 'none', the intact robot: add it or "
+                         "give --intact FILE")  # fmt: skip
+        intact = intact_reach(args.intact, args.robot, args.generated, args.starts)
     results, cache = [], {}
     for name in sets:
         for r in measure(args.robot, name, args.generated, args.starts, args.expected, cache):
             results.append(r)
             print(json.dumps(r), flush=True)
-    with_losses(results)
+    with_losses(results, intact)
     print_table(results)
     if args.out:
         out = {
@@ -224,6 +258,7 @@ def main() -> None:
             "starts_per_maze": args.starts,
             "seed": 0,
             "settings_changed": changes,
+            **({"intact_from": args.intact, "intact_reach_pct": intact} if intact else {}),
             "sets": results,
         }
         atomic_write_text(args.out, json.dumps(out, indent=1) + "\n")
