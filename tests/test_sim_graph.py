@@ -406,6 +406,18 @@ def test_adaptation_turns_on_the_arbitrator_s_and_the_bridge_waits_for_its_odom(
     assert graph_from_arguments({"adaptation": "true"}) == adapting
 
 
+def test_a_recorded_graph_counts_the_recorder_s_subscribers_before_the_first_state():
+    """With a bag the recorder subscribes ``scan`` and ``odom`` too: the bridge waits for
+    two of each, so that the recorder's alone cannot let the first state go out before
+    the sensor nodes' subscriptions are discovered (a CI run lost the radar node's first
+    odometry that way, and the state sent again 30 s later was answered twice)."""
+    bag = sim_graph(bag="run-bag").node("sim_bridge").parameters
+    assert bag["wait_for_subscribers"] == ["scan", "odom", "scan", "odom"]
+    assert bag["wait_for_ready"] == ["recorder/ready"]
+    both = sim_graph(bag="run-bag", adaptation=True).node("sim_bridge").parameters
+    assert sorted(both["wait_for_subscribers"]) == ["odom", "odom", "odom", "scan", "scan"]
+
+
 def test_adaptation_expected_settled_is_the_arbitrator_s_parameter():
     """evorbc-sim --adapt-expected settled, launch adaptation_expected:=settled: the
     arbitrator reads the settled outcomes shipped beside the repertoire; the default

@@ -357,8 +357,19 @@ def sim_graph(
     # Lockstep answers each state once: a first scan or odometry lost to a best-effort
     # match still completing would never be answered (docs/design.md section 9).
     inputs = {"input_qos": "reliable"} if mode == "lockstep" else {}
-    if adaptation:  # a topic named twice needs two subscribers
-        ready["wait_for_subscribers"] = [*bridge_default("wait_for_subscribers"), "odom"]
+    # A topic named k times needs k subscribers. The recorder's own subscriptions of the
+    # waited topics count too: without them in the count, the recorder's subscription
+    # alone let the first state go out before the bridge had discovered the radar node's
+    # (a DDS announcement lost under load is repeated only 3 s later); the radar node
+    # missed the state, and the state sent again after lockstep_timeout was answered
+    # twice by the laser node, shifting every later cycle (docs/design.md section 9).
+    waited = list(bridge_default("wait_for_subscribers"))
+    if adaptation:  # the arbitrator's odom beside the radar node's
+        waited.append("odom")
+    if bag:
+        waited += [t for t in bridge_default("wait_for_subscribers") if t in RECORDED]
+    if waited != list(bridge_default("wait_for_subscribers")):
+        ready["wait_for_subscribers"] = waited
     return SimGraph(
         (
             *([recorder] if bag else []),

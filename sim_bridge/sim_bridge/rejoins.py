@@ -8,7 +8,10 @@ ros-graph.md, "One graph per domain").
 
 The GIDs a node comes back with are compared with every GID seen since the graph
 connected, not with those visible when the cycle began: a lease can lapse across a cycle
-boundary, and a node absent at that moment would otherwise look new when it returns.
+boundary, and a node absent at that moment would otherwise look new when it returns. They
+are also learned while nothing is missing: an endpoint discovered after the graph connected
+(a subscriber the run does not wait for, or one found late under load) would otherwise look
+new after its node's first lapse, and the state sent again would be answered twice.
 """
 
 from __future__ import annotations
@@ -28,8 +31,9 @@ class RejoinWatch:
     def check(self, gone: list[str], endpoints) -> str:
         """One look at the graph: ``gone`` are the topics that lack a node now.
 
-        ``endpoints`` is a callable returning the visible endpoints; it is called only
-        when a missing node is back.
+        ``endpoints`` is a callable returning the visible endpoints; it is called when
+        nothing is missing (to learn endpoints discovered late) and when a missing node is
+        back.
 
         Returns:
             ``"left"`` when a node has just been found missing, ``"new"`` when a missing
@@ -41,6 +45,7 @@ class RejoinWatch:
             left, self.away = not self.away, True
             return "left" if left else ""
         if not self.away:
+            self.seen |= frozenset(endpoints())
             return ""
         self.away = False
         back = frozenset(endpoints())
