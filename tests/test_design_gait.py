@@ -7,6 +7,7 @@ writes a settings file that loads as the design chosen with its record, and refu
 input in one line.
 """
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -133,3 +134,19 @@ def test_bad_input_is_refused_in_one_line(capsys, tmp_path):
     foreign.write_text(json.dumps({"kind": "design-gait", "version": 1, "seed": 9}))
     err = refusal(capsys, str(A1), "--out", out, "--checkpoint", str(foreign))
     assert "another search's" in err and "--restart" in err
+
+
+def test_validation_chains_a_trial_repertoire_s_primitives(tmp_path):
+    """With ``trial_evaluations`` each validated design grows a small repertoire, and its
+    primitives, not random gaits, are chained for the switching measure: the A1's
+    repertoire fell where random gaits did not (offline_evolution/gait_design/trial.py)."""
+    budget = dataclasses.replace(TINY, trial_evaluations=24, trial_episodes=1)
+    lines = []
+    result = design_gait(A1, tmp_path / "a1.yaml", 5, "tiny", budget, progress=lines.append)
+    for c in result.candidates:
+        trial = c.measures.trial_primitives
+        assert (trial > 0) == (c.stage == "validate"), (c.stage, trial)
+        if trial:
+            assert c.measures.trial_reach > 0.0 and c.measures.exposure > 0.0
+    validated = [line for line in lines if "(validate)" in line]
+    assert validated and all(" among a trial repertoire's " in line for line in validated)

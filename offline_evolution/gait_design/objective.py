@@ -74,20 +74,23 @@ class Budget:
     sobol: int  # designs of the space-filling stage (a power of 2)
     refine: int  # designs of the local refinement
     validate: int  # best designs measured again on fresh primitives
+    # Validation's switching on a trial repertoire of each validated design (trial.py):
+    # its evaluations (0: chain random gaits, as the search stages do) and its episodes,
+    # each as long as the robot's maze episode.
+    trial_evaluations: int = 0
+    trial_episodes: int = 0
 
     def as_dict(self) -> dict:
         """Plain data (recorded in the checkpoint)."""
         return asdict(self)
 
 
-#: ``--budget``: quick fits about 10 min on one core for the A1 (docs/legged.md). The
-#: switching episodes simulate as much as before walls came (quick 12 x 5 s, full 20 x
-#: 10 s), in fewer, longer episodes: pressing against a wall takes time to fell a robot.
+#: ``--budget`` (fields in :class:`Budget`'s order): quick fits about 10 min on one core
+#: for the A1 (docs/legged.md), plus about a minute on 2 cores per validated design for
+#: its trial repertoire. The switching episodes simulate as much as before walls came
+#: (quick 12 x 5 s, full 20 x 10 s), in fewer, longer episodes: pressing against a wall
+#: takes time to fell a robot.
 BUDGETS = {
-    "quick": Budget(
-        gaits=40, accuracy=8, episodes=6, episode_time=10.0, sobol=32, refine=32, validate=3
-    ),
-    "full": Budget(
-        gaits=60, accuracy=12, episodes=10, episode_time=20.0, sobol=64, refine=64, validate=5
-    ),
+    "quick": Budget(40, 8, 6, 10.0, 32, 32, 3, trial_evaluations=2000, trial_episodes=10),
+    "full": Budget(60, 12, 10, 20.0, 64, 64, 5, trial_evaluations=6000, trial_episodes=20),
 }

@@ -9,7 +9,10 @@ random primitives (common random numbers, so that designs differ by design, not 
    (Gaussian, standard deviation 0.2 shrinking to 0.03), ``budget.refine`` designs;
 4. validation: the best ``budget.validate`` designs and the current one, measured again on
    fresh primitives; the best of them by this second score is chosen, so that the choice
-   is not the luckiest of many noisy scores.
+   is not the luckiest of many noisy scores. With ``budget.trial_evaluations``, each
+   grows a trial repertoire (:mod:`offline_evolution.gait_design.trial`) whose primitives,
+   not random gaits, are chained for the switching measure: a repertoire's gaits are
+   faster, and fall more when switched.
 
 Every scored design is appended to a JSON checkpoint, written atomically; a rerun with
 the same file, seed and budget replays it and scores only what is missing, so the result
@@ -18,6 +21,7 @@ is the same as an uninterrupted run's.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import time
@@ -39,10 +43,18 @@ from offline_evolution.checkpoint import (
 from offline_evolution.gait_design.maze_needs import MazeNeeds
 from offline_evolution.gait_design.objective import Budget, score
 from offline_evolution.gait_design.space import DesignSpace, key
-from sim_bridge.legged.gait_measures import DesignMeasures, measure_design, reference_rows
+from offline_evolution.gait_design.trial import trial_repertoire
+from sim_bridge.legged.gait_measures import (
+    DesignMeasures,
+    measure_design,
+    reference_rows,
+    survival,
+    switching_falls,
+)
 
 KIND = "design-gait"
-VERSION = 2  # 2: switching among walls over a maze episode, speed against the maze
+VERSION = 3  # 2: switching among walls over a maze episode, speed against the maze;
+# 3: validation's switching on a trial repertoire
 
 
 @dataclass(frozen=True)
@@ -205,6 +217,8 @@ class DesignSearch:
                 self.room,
                 self.needs.episode_time,
             )
+            if stage == "validate" and b.trial_evaluations:
+                measures = self._trial_switching(design, measures)
             s = score(measures, values["rate_hz"], self.needs.required_speed)
             wall, cpu = time.perf_counter() - start, time.process_time() - cpu
             result = Scored(stage, values, measures, s, wall, cpu)
@@ -214,6 +228,28 @@ class DesignSearch:
         self.progress(self._line(result))
         return result
 
+    def _trial_switching(self, design, measures: DesignMeasures) -> DesignMeasures:
+        """``measures`` with switching measured on a trial repertoire of ``design``."""
+        b = self.budget
+        trial = trial_repertoire(design, b.trial_evaluations, self.seed + 2)
+        falls, exposure = switching_falls(
+            design,
+            trial.genes,
+            trial.x > 0.0,
+            b.trial_episodes,
+            self.needs.episode_time,
+            self.seed + 3,
+            self.room,
+        )
+        return dataclasses.replace(
+            measures,
+            switching=survival(falls, exposure, self.needs.episode_time),
+            falls=falls,
+            exposure=exposure,
+            trial_primitives=len(trial.genes),
+            trial_reach=trial.reach,
+        )
+
     def _line(self, r: Scored) -> str:
         v, m = r.values, r.measures
         scales = ", ".join(f"{g} x{s:.2f}" for g, s in v["scale"].items())
@@ -221,11 +257,17 @@ class DesignSearch:
         when = (
             f"{r.seconds:.1f} s, CPU {r.cpu_seconds:.1f} s" if r.seconds else "from the checkpoint"
         )
+        trial = (
+            f" among a trial repertoire's {m.trial_primitives} primitives, median "
+            f"{m.trial_reach:.2f} m"
+            if m.trial_primitives
+            else ""
+        )
         return (
             f"design {len(self.done)} ({r.stage}): gain {v['gain']:g}/s, "
             f"{v['frequency_hz']:g} Hz gait, {v['rate_hz']:g} Hz physics, ranges {scales}: "
             f"upright {m.upright:.0%}, switching {m.switching:.0%} ({m.falls} falls in "
-            f"{m.exposure:.0f} s), error {error}, reach {m.reach:.2f} m, speed "
+            f"{m.exposure:.0f} s{trial}), error {error}, reach {m.reach:.2f} m, speed "
             f"{m.speed:.2f} m/s, {m.ms_per_evaluation:.0f} ms/eval -> score {r.score:.3f} "
             f"[{when}]"
         )

@@ -108,6 +108,57 @@ def switching_episode(sim: LeggedSim, table, rows: np.ndarray, hold: int, fallen
     return math.isfinite(fall_time(sim, table, rows, hold, fallen))
 
 
+def switching_falls(
+    settings: LeggedRobotSettings,
+    genes: np.ndarray,
+    forward: np.ndarray,
+    episodes: int,
+    episode_time: float,
+    seed: int,
+    walls: np.ndarray | None = None,
+) -> tuple[int, float]:
+    """Chain ``genes`` at random every control cycle: ``(episodes that fell, s simulated)``.
+
+    Every other episode runs in free space from the rest pose; with ``walls`` the others
+    start at the room's centre facing a random heading and chain only the primitives
+    that carry the body forward (``forward``, ``(n,)`` bool, x > 0 m in the start frame):
+    they press against a wall, as an arbitrator steering for a target beyond one does.
+
+    Args:
+        genes: ``(n, 1 + 3 k)`` primitives, the pool.
+        episode_time: s, each episode (a whole number of control periods).
+        seed: of the sequences and headings.
+
+    """
+    falls, exposure = 0, 0.0
+    if not len(genes) or not episodes:
+        return falls, exposure
+    period = settings.control_period
+    ahead = np.flatnonzero(forward)
+    with LeggedSim(settings, walls) as room:
+        table = room.gait_table(genes)
+        rng = np.random.default_rng(seed)
+        cycles = round(episode_time / period)
+        for k in range(episodes):
+            heading = float(rng.uniform(-math.pi, math.pi))
+            walled = walls is not None and k % 2 == 1 and len(ahead) > 0
+            pool = ahead if walled else np.arange(len(genes))
+            sequence = pool[rng.integers(len(pool), size=cycles)]
+            pose = (0.0, 0.0, heading) if walled else None
+            fell = fall_time(room, table, sequence, 1, settings.fallen_tilt, pose)
+            falls += math.isfinite(fell)
+            exposure += min(fell, cycles * period)
+    return falls, exposure
+
+
+def survival(falls: int, exposure: float, maze_time: float) -> float:
+    """The probability of a ``maze_time``-s episode without a fall.
+
+    At a constant rate of ``falls`` per ``exposure`` s; 0 when nothing was simulated.
+    """
+    return math.exp(-falls * maze_time / exposure) if exposure > 0 else 0.0
+
+
 def joint_limits(settings: LeggedRobotSettings) -> tuple[np.ndarray, np.ndarray]:
     """``(joints,)`` lower and upper limits (rad) of the actuated joints, in command order.
 
@@ -134,6 +185,11 @@ class DesignMeasures:
     speed: float  # m/s, SPEED_PERCENTILE of the upright primitives' distance / T (0: none)
     falls: int  # switching episodes that fell
     exposure: float  # s of switching simulated (each episode to its fall or end)
+    # A trial repertoire's (validation only; offline_evolution/gait_design/trial.py):
+    # its primitives (0: none grown) and their median distance after T (m). Its
+    # switching then replaces the random gaits' in ``switching``, ``falls``, ``exposure``.
+    trial_primitives: int = 0
+    trial_reach: float = 0.0
 
     def as_dict(self) -> dict:
         """Plain data (JSON-safe; an infinite error is written as None)."""
@@ -193,29 +249,13 @@ def measure_design(
     upright = rows[:, TILT] <= discard
     reach = np.hypot(rows[upright, X], rows[upright, Y])
     steady = np.flatnonzero(rows[:, TILT] <= POOL_TILT)
-    falls, exposure = 0, 0.0
-    if len(steady) and episodes:
-        # Indices into the pool of the steady primitives that carry the body forward (m,
-        # start frame): chained facing a wall, they press against it, as an arbitrator
-        # steering for a target beyond a wall does.
-        forward = np.flatnonzero(rows[steady, X] > 0.0)
-        with LeggedSim(settings, walls) as room:
-            table = room.gait_table(genes[steady])
-            rng = np.random.default_rng(seed)
-            cycles = round(episode_time / period)
-            for k in range(episodes):
-                heading = float(rng.uniform(-math.pi, math.pi))
-                walled = walls is not None and k % 2 == 1 and len(forward) > 0
-                pool = forward if walled else np.arange(len(steady))
-                sequence = pool[rng.integers(len(pool), size=cycles)]
-                pose = (0.0, 0.0, heading) if walled else None
-                fell = fall_time(room, table, sequence, 1, settings.fallen_tilt, pose)
-                falls += math.isfinite(fell)
-                exposure += min(fell, cycles * period)
+    falls, exposure = switching_falls(
+        settings, genes[steady], rows[steady, X] > 0.0, episodes, episode_time, seed, walls
+    )
     errors = endpoint_errors(full, reference, discard)
     return DesignMeasures(
         upright=float(upright.mean()),
-        switching=math.exp(-falls * maze_time / exposure) if exposure > 0 else 0.0,
+        switching=survival(falls, exposure, maze_time),
         endpoint_error=float(np.median(errors)) if len(errors) else math.inf,
         reach=float(np.median(reach)) if len(reach) else 0.0,
         ms_per_evaluation=1e3 * cost,
