@@ -23,9 +23,9 @@ import math
 import time
 
 import numpy as np
+from legged_bench_input import load_legged
 
 from evorbc_ros.atomic_io import atomic_write_text
-from evorbc_ros.repertoire import Repertoire
 
 #: deg: the discard tilts compared (the shipped robots' is 45).
 THRESHOLDS = (10, 15, 20, 25, 30, 35, 45)
@@ -49,9 +49,7 @@ def held(sim, table, row: int, hold: float, fallen: float) -> tuple[float, float
 
 
 def main() -> None:
-    from evorbc_ros.robots.registry import lookup
     from sim_bridge.legged.physics import LeggedSim
-    from sim_bridge.legged.settings import load_robot_settings
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("repertoire")
@@ -59,8 +57,7 @@ def main() -> None:
     parser.add_argument("--hold", type=float, default=30.0, help="s each primitive is held")
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
-    rep = Repertoire.load(args.repertoire)
-    settings = load_robot_settings(args.settings or lookup(rep.robot).model.path())
+    rep, settings = load_legged(args.repertoire, getattr(args, "settings", None))
     began = time.process_time()
     with LeggedSim(settings) as sim:
         table = sim.gait_table(rep.genes)

@@ -26,9 +26,9 @@ import math
 import time
 
 import numpy as np
+from legged_bench_input import load_legged
 
 from evorbc_ros.atomic_io import atomic_write_text
-from evorbc_ros.repertoire import Repertoire
 
 
 def switching(sim, table, rows: np.ndarray, period: float, fallen: float, blend: float) -> float:
@@ -57,9 +57,7 @@ def switching(sim, table, rows: np.ndarray, period: float, fallen: float, blend:
 
 
 def main() -> None:
-    from evorbc_ros.robots.registry import lookup
     from sim_bridge.legged.physics import LeggedSim
-    from sim_bridge.legged.settings import load_robot_settings
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("repertoire")
@@ -71,8 +69,7 @@ def main() -> None:
     parser.add_argument("--blend", type=float, default=0.0, help="s a switch's ramp lasts")
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
-    rep = Repertoire.load(args.repertoire)
-    settings = load_robot_settings(args.settings or lookup(rep.robot).model.path())
+    rep, settings = load_legged(args.repertoire, getattr(args, "settings", None))
     began = time.process_time()
     rows = []
     with LeggedSim(settings) as sim:

@@ -23,9 +23,9 @@ import json
 import time
 
 import numpy as np
+from legged_bench_input import load_legged
 
 from evorbc_ros.atomic_io import atomic_write_text
-from evorbc_ros.repertoire import Repertoire
 
 
 def transition(sim, table, before: int, after: int, lead: int, hold: int, fallen: float) -> int:
@@ -40,9 +40,7 @@ def transition(sim, table, before: int, after: int, lead: int, hold: int, fallen
 
 
 def main() -> None:
-    from evorbc_ros.robots.registry import lookup
     from sim_bridge.legged.physics import LeggedSim
-    from sim_bridge.legged.settings import load_robot_settings
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("repertoire")
@@ -54,8 +52,7 @@ def main() -> None:
     parser.add_argument("--out", help="write the repertoire without the dropped primitives")
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
-    rep = Repertoire.load(args.repertoire)
-    settings = load_robot_settings(lookup(rep.robot).model.path())
+    rep, settings = load_legged(args.repertoire, getattr(args, "settings", None))
     dt = settings.physics.dt
     lead, hold = round(args.lead / dt), round(args.hold / dt)
     rng = np.random.default_rng(args.seed)
