@@ -443,6 +443,7 @@ def recorded(tmp_path_factory):
          "--domain-id", str(claim_domain(RECORD))],
         env=graph_env(RECORD), capture_output=True, text=True, timeout=300,
     )  # fmt: skip
+    (tmp / "graph.log").write_text(done.stdout + done.stderr)  # for a failure
     return bag, json.loads(result.read_text()), done.returncode, done.stdout + done.stderr
 
 
@@ -547,8 +548,10 @@ def test_a_recorder_behind_at_the_end_of_the_run_still_gets_all_of_it(tmp_path):
     states = len(json.loads(result.read_text())["trajectory"])
     with BagReader(bag) as reader:
         counts = {t: v.count for t, v in reader.topics.items()}
+    (tmp_path / "graph.log").write_text(out)  # the whole graph's output, for a failure
+    warned = [line for line in seen if "WARN" in line]  # what the graph said went wrong
     for topic in ("/clock", "/scan", "/odom", "/joint_states"):
-        assert counts[topic] == states, (topic, counts)
+        assert counts[topic] == states, (topic, counts, warned)
     assert len(load_recording(bag).cycles) == states
 
 

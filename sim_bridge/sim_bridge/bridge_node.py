@@ -75,10 +75,13 @@ from sim_bridge.rejoins import RejoinWatch
 from sim_bridge.verdict import episode_verdict
 
 #: Longest time (wall s) the lockstep bridge waits, after its final state, for every reader
-#: to acknowledge its state messages. A recorder on a loaded machine may be a few cycles
+#: to acknowledge its state messages. A recorder on a loaded machine may be many cycles
 #: behind when the run ends; a bridge that exits first takes those messages with it
-#: (docs/design/ros-graph.md, "Recording and playback").
-DELIVERY_LIMIT = 10.0
+#: (docs/design/ros-graph.md, "Recording and playback"). 10 s was too short at load 8: a
+#: recorder 320 cycles behind had taken every /clock, /scan and /odom but 507 of 819
+#: /joint_states. A reader that never acknowledges is a dead node, which DDS drops at the
+#: end of its lease (20 s), ending the wait: a longer limit costs nothing there.
+DELIVERY_LIMIT = 30.0
 #: Wall s of one wait for acknowledgements between checks for a stop request.
 ACK_SLICE = 0.1
 
@@ -380,9 +383,14 @@ class SimBridgeNode(Node):
         """Wait until the controller's nodes are connected, so no first message is lost.
 
         In lockstep a lost first state would have to be sent again, and nodes that had
-        already seen it would then answer twice.
+        already seen it would then answer twice: a lockstep run therefore starts only
+        with its whole graph, warning every ``startup_timeout`` s while it waits (a
+        loaded machine can take that long to start five processes; a node that fails
+        ends the graph: docs/design/ros-graph.md, "Start-up"). In realtime the run
+        starts without the missing nodes after ``startup_timeout`` s.
         """
         deadline = time.monotonic() + self.startup_timeout
+        began = time.monotonic()
         heard: set[str] = set()
         ready = [
             self.create_subscription(Empty, t, lambda _, t=t: heard.add(t), LATCHED)
@@ -392,8 +400,16 @@ class SimBridgeNode(Node):
         def missing() -> list[str]:
             return self.missing() + [t for t in self.params["wait_for_ready"] if t not in heard]
 
-        while missing() and time.monotonic() < deadline and running():
+        while missing() and running():
             executor.spin_once(timeout_sec=0.05)
+            if time.monotonic() >= deadline:
+                if self.mode != "lockstep":
+                    break
+                self.get_logger().warning(
+                    f"still waiting for {', '.join(missing())} after "
+                    f"{time.monotonic() - began:.0f} s: a lockstep run starts with its whole graph"
+                )
+                deadline += self.startup_timeout
         for sub in ready:
             self.destroy_subscription(sub)
         if not running():

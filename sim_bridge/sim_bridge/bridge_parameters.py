@@ -68,7 +68,14 @@ PARAMETERS = (
         "latched std_msgs/Empty topics to hear on before the run starts (a recorder's "
         "recorder/ready, so that the bag holds the run from its first state)",
     ),
-    spec("startup_timeout", 30.0, "wall seconds to wait for the graph", 0.1, 3600.0),
+    spec(
+        "startup_timeout",
+        30.0,
+        "wall seconds to wait for the graph (lockstep: then warn and wait on; realtime: "
+        "start without what is missing)",
+        0.1,
+        3600.0,
+    ),
     spec("result_file", "", "write the episode result here (JSON)"),
     spec("progress_period", 10.0, "simulated seconds between progress lines", 0.1, 1e6),
     spec("laser_beams", 360, "kinematic robots: laser beams per scan over 360 deg", 1, 100000),
