@@ -57,7 +57,7 @@ def main() -> None:
     parser.add_argument("--hold", type=float, default=30.0, help="s each primitive is held")
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
-    rep, settings = load_legged(args.repertoire, getattr(args, "settings", None))
+    rep, settings = load_legged(args.repertoire, args.settings)
     began = time.process_time()
     with LeggedSim(settings) as sim:
         table = sim.gait_table(rep.genes)

@@ -69,7 +69,7 @@ def main() -> None:
     parser.add_argument("--blend", type=float, default=0.0, help="s a switch's ramp lasts")
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
-    rep, settings = load_legged(args.repertoire, getattr(args, "settings", None))
+    rep, settings = load_legged(args.repertoire, args.settings)
     began = time.process_time()
     rows = []
     with LeggedSim(settings) as sim:

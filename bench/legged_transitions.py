@@ -9,8 +9,8 @@ the lead is not ``b``'s and is not counted. ``--out FILE`` writes the repertoire
 primitives that fell in at least ``--strikes`` of their trials (an experiment on what
 switching-safe primitives would give a controller: docs/your-robot.md).
 
-    python bench/legged_transitions.py REPERTOIRE.json [--trials 6] [--lead 1] [--hold 1]
-        [--strikes 1] [--seed 0] [--out PRUNED.json] [--json FILE]
+    python bench/legged_transitions.py REPERTOIRE.json [--settings MODEL.yaml] [--trials 6]
+        [--lead 1] [--hold 1] [--strikes 1] [--seed 0] [--out PRUNED.json] [--json FILE]
 
 A robot made by a recipe needs its folder on ``$EVORBC_ROBOT_PATH`` (``DIR/robots``).
 """
@@ -44,6 +44,7 @@ def main() -> None:
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("repertoire")
+    parser.add_argument("--settings", help="the legged settings file (default: the robot's)")
     parser.add_argument("--trials", type=int, default=6, help="transitions into each primitive")
     parser.add_argument("--lead", type=float, default=1.0, help="s of the previous primitive")
     parser.add_argument("--hold", type=float, default=1.0, help="s of the primitive after")
@@ -52,7 +53,7 @@ def main() -> None:
     parser.add_argument("--out", help="write the repertoire without the dropped primitives")
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
-    rep, settings = load_legged(args.repertoire, getattr(args, "settings", None))
+    rep, settings = load_legged(args.repertoire, args.settings)
     dt = settings.physics.dt
     lead, hold = round(args.lead / dt), round(args.hold / dt)
     rng = np.random.default_rng(args.seed)

@@ -34,8 +34,9 @@ def add_parsers(sub) -> None:
         "--budget",
         choices=("quick", "full"),
         default="quick",
-        help="quick: about 10 min on one core for the A1; full: more primitives, episodes "
-        "and designs (default quick)",
+        help="quick: about 10 min on one core for the A1, then a trial repertoire for each of "
+        "4 validated designs (1-3 min each on 2 cores); full: more primitives, episodes and "
+        "designs (default quick)",
     )
     add_resume_options(p, ".checkpoint.json (removed once OUT is written)", "designs", 1)
     p.set_defaults(func=cmd_design_gait)

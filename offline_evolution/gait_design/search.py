@@ -238,7 +238,7 @@ class DesignSearch:
             trial.x > 0.0,
             b.trial_episodes,
             self.needs.episode_time,
-            self.seed + 3,
+            [self.seed, 3],  # a stream of its own, as the genes' (no other seed's stream)
             self.room,
         )
         return dataclasses.replace(

@@ -402,14 +402,17 @@ class SimBridgeNode(Node):
 
         while missing() and running():
             executor.spin_once(timeout_sec=0.05)
-            if time.monotonic() >= deadline:
+            now = time.monotonic()
+            if now >= deadline:
                 if self.mode != "lockstep":
                     break
-                self.get_logger().warning(
-                    f"still waiting for {', '.join(missing())} after "
-                    f"{time.monotonic() - began:.0f} s: a lockstep run starts with its whole graph"
-                )
-                deadline += self.startup_timeout
+                gone = missing()
+                if gone:
+                    self.get_logger().warning(
+                        f"still waiting for {', '.join(gone)} after {now - began:.0f} s: "
+                        "a lockstep run starts with its whole graph"
+                    )
+                deadline = now + self.startup_timeout
         for sub in ready:
             self.destroy_subscription(sub)
         if not running():
@@ -432,13 +435,15 @@ class SimBridgeNode(Node):
         its old endpoints (a DDS lease missed on a loaded machine) lost no message: the
         connections are reliable, so nothing is sent again (docs/design.md section 9).
         """
-        sent = checked = time.monotonic()
+        sent = time.monotonic()
         while not all(self.fresh.values()) and running():
             executor.spin_once(timeout_sec=0.01)
             now = time.monotonic()
             rejoined = False
-            if now - checked > 0.1:
-                checked = now
+            # Every 0.1 s of waiting, counted across cycles: fast cycles then still learn
+            # endpoints discovered late (sim_bridge/rejoins.py).
+            if now - self.looked > 0.1:
+                self.looked = now
                 gone = self.missing()
                 seen = self.rejoins.check(gone, self.endpoints)
                 if seen == "left":
@@ -461,6 +466,7 @@ class SimBridgeNode(Node):
             self.wait_for_graph(executor)
             self.check_alone()
             self.rejoins = RejoinWatch(self.endpoints())
+            self.looked = time.monotonic()  # the last look at the graph's endpoints
             self.loop_start = time.monotonic()
             while not self.world.status().done and running():
                 self.fresh = dict.fromkeys(self.fresh, False)

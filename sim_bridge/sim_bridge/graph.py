@@ -305,8 +305,9 @@ def sim_graph(
     controller's task recorded for this maze, else the bridge fits the maze to the robot as
     offline runs do (docs/design.md section 21).
     ``adaptation``: the arbitrator's ``adaptation`` parameter on; the bridge then waits for
-    two subscribers of ``odom`` (the radar node's and the arbitrator's), so that in lockstep
-    the arbitrator sees the first pose and the episode is the offline one
+    two subscribers of ``odom`` (the radar node's and the arbitrator's; three with a bag,
+    the recorder's too), so that in lockstep the arbitrator sees the first pose and the
+    episode is the offline one
     (docs/design/adaptation.md). ``adaptation_expected``: the arbitrator's parameter of
     that name (``recorded`` or ``settled``; passed only when not ``recorded``).
 

@@ -114,7 +114,7 @@ def switching_falls(
     forward: np.ndarray,
     episodes: int,
     episode_time: float,
-    seed: int,
+    seed: int | list[int],
     walls: np.ndarray | None = None,
 ) -> tuple[int, float]:
     """Chain ``genes`` at random every control cycle: ``(episodes that fell, s simulated)``.
@@ -127,7 +127,7 @@ def switching_falls(
     Args:
         genes: ``(n, 1 + 3 k)`` primitives, the pool.
         episode_time: s, each episode (a whole number of control periods).
-        seed: of the sequences and headings.
+        seed: of the sequences and headings (an int or a NumPy seed sequence).
 
     """
     falls, exposure = 0, 0.0
