@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from offline_evolution.gait_design.objective import CELL
 from offline_evolution.repertoire.archive import elites_by_cell
 from offline_evolution.repertoire.map_elites import MapElites
 from offline_evolution.repertoire.settings import MapElitesSettings
@@ -22,7 +23,6 @@ from sim_bridge.legged.gait_measures import T
 from sim_bridge.legged.robot import LeggedRobot
 from sim_bridge.legged.settings import LeggedRobotSettings
 
-CELL = 0.08  # m, the archive cell of the A1's and the hexapod's repertoires
 ITERATIONS = 5  # mutant batches after the random half of the budget
 
 

@@ -389,8 +389,8 @@ class SimBridgeNode(Node):
         ends the graph: docs/design/ros-graph.md, "Start-up"). In realtime the run
         starts without the missing nodes after ``startup_timeout`` s.
         """
-        deadline = time.monotonic() + self.startup_timeout
         began = time.monotonic()
+        deadline = began + self.startup_timeout
         heard: set[str] = set()
         ready = [
             self.create_subscription(Empty, t, lambda _, t=t: heard.add(t), LATCHED)
